@@ -1,0 +1,1 @@
+//! The emoshift library: CLI front ends and the service.

@@ -1,0 +1,2 @@
+//! protocol
+#![warn(missing_docs)]

@@ -1,0 +1,88 @@
+//! Format dispatch by file extension, and whole-file load/save.
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Write};
+use std::path::Path;
+
+use crate::error::{ReadError, WriteError};
+use crate::{c3d, csv, trc, Take};
+
+/// The take formats emoshift reads and writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// C3D (read through c3dio, written by [`crate::c3d::write`] as Intel float32).
+    C3d,
+    /// TRC, the OpenSim / Motion Analysis text layout.
+    Trc,
+    /// CSV: `frame,time,<label>_x,<label>_y,<label>_z,...`.
+    Csv,
+}
+
+impl Format {
+    /// The format a path's extension names, if any (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Format::from_name(&ext)
+    }
+
+    /// The format named `c3d`, `trc` or `csv` (case-insensitive).
+    pub fn from_name(name: &str) -> Option<Format> {
+        match name.to_ascii_lowercase().as_str() {
+            "c3d" => Some(Format::C3d),
+            "trc" => Some(Format::Trc),
+            "csv" => Some(Format::Csv),
+            _ => None,
+        }
+    }
+
+    /// The file extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::C3d => "c3d",
+            Format::Trc => "trc",
+            Format::Csv => "csv",
+        }
+    }
+}
+
+/// Reads a take from a file, choosing the format by extension.
+///
+/// # Errors
+/// [`ReadError::UnknownFormat`] for an unsupported extension, otherwise whatever the format's
+/// reader reports (I/O, malformed or truncated content, invalid values).
+pub fn load(path: &Path) -> Result<Take, ReadError> {
+    let format = Format::from_path(path).ok_or_else(|| ReadError::UnknownFormat(path.into()))?;
+    let reader = BufReader::new(File::open(path)?);
+    let take = match format {
+        Format::C3d => c3d::read(reader)?,
+        Format::Trc => trc::read(reader)?,
+        Format::Csv => csv::read(reader)?,
+    };
+    take.validate()?;
+    Ok(take)
+}
+
+/// Writes a take to a file, choosing the format by extension.
+///
+/// # Errors
+/// [`WriteError::UnknownFormat`] for an unsupported extension, an invalid take, or I/O failure.
+pub fn save(path: &Path, take: &Take) -> Result<(), WriteError> {
+    let format = Format::from_path(path).ok_or_else(|| WriteError::UnknownFormat(path.into()))?;
+    take.validate()?;
+    let mut out = BufWriter::new(File::create(path)?);
+    write_as(format, take, &mut out)?;
+    out.flush()?;
+    Ok(())
+}
+
+/// Writes a take in the given format to any writer.
+///
+/// # Errors
+/// An invalid take, a take the format cannot hold, or I/O failure.
+pub fn write_as(format: Format, take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
+    match format {
+        Format::C3d => c3d::write(take, out),
+        Format::Trc => trc::write(take, out),
+        Format::Csv => csv::write(take, out),
+    }
+}

@@ -1,0 +1,18 @@
+//! Recorded takes on disk (C3D, TRC, CSV), the synthetic face generator and the replay pacer.
+//!
+//! Main types: [`Take`] (labels, rate, first frame, positions in mm, missing mask), [`Format`],
+//! [`load`] and [`save`].
+//!
+//! This crate must not know about ICA models (the daemon joins takes and models).
+#![warn(missing_docs)]
+
+pub mod c3d;
+pub mod csv;
+pub mod error;
+pub mod format;
+pub mod take;
+pub mod trc;
+
+pub use error::{ReadError, TakeError, WriteError};
+pub use format::{load, save, write_as, Format};
+pub use take::{Take, Units};

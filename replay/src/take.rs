@@ -1,0 +1,203 @@
+//! The in-memory take: what every reader produces and every writer consumes.
+
+use crate::error::TakeError;
+
+/// Length units a file may declare; everything in memory is millimetres.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Units {
+    /// Millimetres (the in-memory unit).
+    #[default]
+    Millimetres,
+    /// Centimetres (x10 on read).
+    Centimetres,
+    /// Metres (x1000 on read).
+    Metres,
+}
+
+impl Units {
+    /// Parses a units field such as `mm`, `cm`, `m` (case-insensitive, trimmed).
+    pub fn parse(text: &str) -> Option<Units> {
+        match text.trim().trim_matches('\0').to_ascii_lowercase().as_str() {
+            "mm" | "millimeters" | "millimetres" => Some(Units::Millimetres),
+            "cm" | "centimeters" | "centimetres" => Some(Units::Centimetres),
+            "m" | "meters" | "metres" => Some(Units::Metres),
+            _ => None,
+        }
+    }
+
+    /// Factor that converts a value in these units to millimetres.
+    pub fn to_mm(self) -> f32 {
+        match self {
+            Units::Millimetres => 1.0,
+            Units::Centimetres => 10.0,
+            Units::Metres => 1000.0,
+        }
+    }
+
+    /// The short name written to files (`mm`, `cm`, `m`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Units::Millimetres => "mm",
+            Units::Centimetres => "cm",
+            Units::Metres => "m",
+        }
+    }
+}
+
+/// A recorded take: marker labels, frame rate, first frame number, positions in millimetres and a
+/// per-sample missing mask.
+///
+/// Layout: `positions[(frame * n_markers + marker) * 3 + axis]` and
+/// `missing[frame * n_markers + marker]`. A missing sample's position is stored as `0.0` and must
+/// be ignored; the mask is authoritative.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Take {
+    /// Marker labels, one per marker, in file order.
+    pub labels: Vec<String>,
+    /// Frames per second.
+    pub rate_hz: f64,
+    /// Frame number of the first frame, as the file numbers it (C3D and TRC usually start at 1).
+    pub first_frame: i64,
+    /// Positions, frames x markers x 3, millimetres.
+    pub positions: Vec<f32>,
+    /// Missing mask, frames x markers.
+    pub missing: Vec<bool>,
+    /// Units the source file declared (values are already converted to millimetres).
+    pub source_units: Units,
+}
+
+impl Take {
+    /// An empty take with the given labels and rate.
+    pub fn new(labels: Vec<String>, rate_hz: f64, first_frame: i64) -> Take {
+        Take {
+            labels,
+            rate_hz,
+            first_frame,
+            positions: Vec::new(),
+            missing: Vec::new(),
+            source_units: Units::Millimetres,
+        }
+    }
+
+    /// Number of markers.
+    pub fn n_markers(&self) -> usize {
+        self.labels.len()
+    }
+
+    /// Number of frames.
+    pub fn n_frames(&self) -> usize {
+        self.missing.len().checked_div(self.n_markers()).unwrap_or(0)
+    }
+
+    /// Positions of one frame: markers x 3.
+    ///
+    /// # Panics
+    /// If `frame >= self.n_frames()`.
+    pub fn frame(&self, frame: usize) -> &[f32] {
+        let w = self.n_markers() * 3;
+        &self.positions[frame * w..(frame + 1) * w]
+    }
+
+    /// Missing mask of one frame: one flag per marker.
+    ///
+    /// # Panics
+    /// If `frame >= self.n_frames()`.
+    pub fn frame_missing(&self, frame: usize) -> &[bool] {
+        let n = self.n_markers();
+        &self.missing[frame * n..(frame + 1) * n]
+    }
+
+    /// Whether a sample is missing.
+    pub fn is_missing(&self, frame: usize, marker: usize) -> bool {
+        self.missing[frame * self.n_markers() + marker]
+    }
+
+    /// Position of one sample, `None` when missing.
+    pub fn sample(&self, frame: usize, marker: usize) -> Option<[f32; 3]> {
+        if self.is_missing(frame, marker) {
+            return None;
+        }
+        let i = (frame * self.n_markers() + marker) * 3;
+        Some([self.positions[i], self.positions[i + 1], self.positions[i + 2]])
+    }
+
+    /// Appends one frame. `xyz` is markers x 3 (mm); `missing` one flag per marker. Positions of
+    /// missing samples are stored as zero.
+    ///
+    /// # Panics
+    /// If the slice lengths do not match the marker count.
+    pub fn push_frame(&mut self, xyz: &[f32], missing: &[bool]) {
+        let n = self.n_markers();
+        assert_eq!(xyz.len(), n * 3, "frame must hold markers x 3 values");
+        assert_eq!(missing.len(), n, "mask must hold one flag per marker");
+        for (m, &gone) in missing.iter().enumerate() {
+            if gone {
+                self.positions.extend_from_slice(&[0.0; 3]);
+            } else {
+                self.positions.extend_from_slice(&xyz[m * 3..m * 3 + 3]);
+            }
+        }
+        self.missing.extend_from_slice(missing);
+    }
+
+    /// Time in seconds of frame index `frame` (0-based), counted from the first frame.
+    pub fn time_of(&self, frame: usize) -> f64 {
+        frame as f64 / self.rate_hz
+    }
+
+    /// Number of missing samples per marker.
+    pub fn missing_per_marker(&self) -> Vec<usize> {
+        let n = self.n_markers();
+        let mut counts = vec![0; n];
+        for (i, &gone) in self.missing.iter().enumerate() {
+            if gone {
+                counts[i % n] += 1;
+            }
+        }
+        counts
+    }
+
+    /// Index of a marker by label.
+    pub fn marker_index(&self, label: &str) -> Option<usize> {
+        self.labels.iter().position(|l| l == label)
+    }
+
+    /// Checks the invariants every reader and writer relies on.
+    ///
+    /// # Errors
+    /// A [`TakeError`] naming the broken invariant: buffer sizes, a non-finite or non-positive
+    /// rate, a non-finite present sample, duplicate or empty labels.
+    pub fn validate(&self) -> Result<(), TakeError> {
+        let n = self.n_markers();
+        if n == 0 {
+            return Err(TakeError::NoMarkers);
+        }
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
+            return Err(TakeError::BadRate(self.rate_hz));
+        }
+        if self.missing.len() % n != 0 || self.positions.len() != self.missing.len() * 3 {
+            return Err(TakeError::ShapeMismatch {
+                markers: n,
+                positions: self.positions.len(),
+                mask: self.missing.len(),
+            });
+        }
+        for (i, label) in self.labels.iter().enumerate() {
+            if label.trim().is_empty() {
+                return Err(TakeError::EmptyLabel { marker: i });
+            }
+            if self.labels[..i].contains(label) {
+                return Err(TakeError::DuplicateLabel(label.clone()));
+            }
+        }
+        for (i, &gone) in self.missing.iter().enumerate() {
+            if !gone && self.positions[i * 3..i * 3 + 3].iter().any(|v| !v.is_finite()) {
+                return Err(TakeError::NonFinite {
+                    frame: i / n,
+                    marker: self.labels[i % n].clone(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
