@@ -58,6 +58,107 @@ pub enum ReadError {
     /// The content parsed but breaks a take invariant.
     #[error(transparent)]
     Invalid(#[from] TakeError),
+    /// A text line is not valid UTF-8.
+    #[error("line {line} is not valid utf-8")]
+    NotUtf8 {
+        /// 1-based line number.
+        line: usize,
+    },
+    /// The input ended before a required header line.
+    #[error("input ends at line {line}, expected {expected}")]
+    UnexpectedEnd {
+        /// 1-based number of the line that is missing.
+        line: usize,
+        /// What that line should have held.
+        expected: &'static str,
+    },
+    /// A header line does not have the shape the format requires.
+    #[error("line {line}: expected {expected}, found {found:?}")]
+    BadHeader {
+        /// 1-based line number.
+        line: usize,
+        /// What the line should hold.
+        expected: &'static str,
+        /// The offending text.
+        found: String,
+    },
+    /// One cell does not hold what its column requires (a non-numeric or infinite sample, a bad
+    /// frame number).
+    #[error("line {line}, column {column} ({field}): expected {expected}, found {found:?}")]
+    BadCell {
+        /// 1-based line number.
+        line: usize,
+        /// 1-based column number.
+        column: usize,
+        /// What the column holds, e.g. `Chin y` or `Frame#`.
+        field: String,
+        /// What the cell should hold.
+        expected: &'static str,
+        /// The offending cell text.
+        found: String,
+    },
+    /// A row has more (or, where the format forbids it, fewer) cells than the header.
+    #[error("line {line}: expected {expected} columns, found {found}")]
+    ColumnCount {
+        /// 1-based line number.
+        line: usize,
+        /// Columns the header defines.
+        expected: usize,
+        /// Columns the row holds.
+        found: usize,
+    },
+    /// A row ends in the middle of one marker's x/y/z cells.
+    #[error("line {line}: row ends inside marker {marker:?} after {cells} of its 3 cells")]
+    TruncatedRow {
+        /// 1-based line number.
+        line: usize,
+        /// Label of the cut marker.
+        marker: String,
+        /// Cells of that marker present (1 or 2).
+        cells: usize,
+    },
+    /// Frame numbers are not consecutive.
+    #[error("line {line}: expected frame number {expected}, found {found}")]
+    FrameGap {
+        /// 1-based line number.
+        line: usize,
+        /// The frame number that should follow.
+        expected: i64,
+        /// The frame number the row holds.
+        found: i64,
+    },
+    /// The header's frame count disagrees with the data rows (a truncated file, usually).
+    #[error("header declares {declared} frames but the data holds {found}")]
+    FrameCountMismatch {
+        /// Frames the header declares.
+        declared: usize,
+        /// Data rows found.
+        found: usize,
+    },
+    /// The header's marker count disagrees with the marker names it lists.
+    #[error("header declares {declared} markers but names {found}")]
+    MarkerCountMismatch {
+        /// Markers the header declares.
+        declared: usize,
+        /// Marker names found.
+        found: usize,
+    },
+    /// No frame rate is declared and too few frames exist to derive one.
+    #[error("cannot derive a frame rate from {frames} frame(s); declare one with `# rate_hz=...`")]
+    NoRate {
+        /// Frames in the file.
+        frames: usize,
+    },
+    /// The time column does not advance evenly enough to derive a frame rate.
+    #[error("line {line}: time step {step_s} s is not within 0.5-1.5x the mean step {mean_step_s} s")]
+    UnevenTime {
+        /// 1-based line number of the later row.
+        line: usize,
+        /// The step from the previous row, seconds.
+        step_s: f64,
+        /// The mean step over the file, seconds.
+        mean_step_s: f64,
+    },
 }
 
 /// Why a take could not be written.
@@ -72,6 +173,16 @@ pub enum WriteError {
     /// The take cannot be represented in the target format; the text says why.
     #[error("{0}")]
     Unrepresentable(String),
+    /// A marker label holds a character the text format uses as a separator.
+    #[error("marker label {label:?} contains {forbidden:?}, which {format} cannot hold in a label")]
+    LabelUnrepresentable {
+        /// The format being written (`trc`, `csv`).
+        format: &'static str,
+        /// The label.
+        label: String,
+        /// The offending character.
+        forbidden: char,
+    },
     /// The take breaks an invariant.
     #[error(transparent)]
     Invalid(#[from] TakeError),
