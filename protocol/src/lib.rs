@@ -1,2 +1,120 @@
-//! protocol
+//! OSC 1.0 wire formats of emoshift: marker frames, labels, output profiles and control.
+//!
+//! Sans-IO: every function takes bytes and returns values, or writes into a caller
+//! `Vec<u8>`. No sockets, no clock, no threads, no logging; the daemon owns all of those.
+//!
+//! # Address space
+//!
+//! Big-endian, 4-byte aligned OSC 1.0 over UDP. `i` int32, `h` int64, `f` float32, `s` string,
+//! `b` blob.
+//!
+//! | Address | Tags | Direction | Meaning |
+//! |---|---|---|---|
+//! | `/mocap/frame` | `,ihbb` | source → daemon, daemon → compact clients | frame number; capture time µs (sender's clock); missing-marker bitmask (marker i = bit i mod 8, LSB first, of byte i div 8); positions, markers × 3 f32 mm, x y z |
+//! | `/mocap/frame` | `,ih` + 3n × `f` | source → daemon | flat form, a marker with all three NaN is missing |
+//! | `/mocap/labels` | `,i` + n × `s` | source → daemon, at start and every second | layout id, marker names in frame order |
+//! | `/emoshift/state` | `,sf` | daemon → compact | target emotion, current amount (after the frame, same bundle) |
+//! | `/mocap/part` | `,iiii` + 3k × `f` | daemon → flat-split | frame number, first marker, k markers here, markers in frame, then x y z per marker (NaN = missing); each ≤ 1,472 bytes |
+//! | `/emoshift/components` | n × `f` | daemon → components | current u |
+//! | `/VMC/Ext/Blend/Val` | `,sf` | daemon → components | one per labelled component: name, value |
+//! | `/VMC/Ext/Blend/Apply` | `,` | daemon → components | closes the VMC values of one frame |
+//! | `/emotion/target` | `,s` | control | target emotion |
+//! | `/emotion/amount` | `,f` | control | edit amount (finite) |
+//! | `/emotion/ramp` | `,f` | control | ramp time, seconds ≥ 0 |
+//! | `/emotion/alpha` | `,if` | control | raw translate of component i |
+//! | `/component/gain` | `,if` | control | gain of component i |
+//! | `/bypass` | `,i` | control | non-zero: pass frames through unedited |
+//! | `/subscribe` | `,is` | control | port on the sender's host, profile (`compact`, `flat-split`, `components`) |
+//! | `/unsubscribe` | `,i` | control | port on the sender's host |
+//! | `/model/load` | `,s` | control | model path |
+//! | `/record/start` | `,s` | control | recording path |
+//! | `/record/stop` | `,` | control | |
+//! | `/status` | `,` | control | asks for the counters |
+//! | `<control>/confirm` | as the control | reply | accepted; echoes the arguments in canonical types |
+//! | `/status/confirm` | (`s` `h`)* | reply | counters as name, int64 value pairs, in the daemon's order |
+//! | `/emoshift/error` | `,ss` | reply | address of the refused message, why |
+//!
+//! Float control arguments also accept `i` and `d`; `/bypass` also accepts `T`/`F`.
+//!
+//! # Decisions
+//!
+//! - **Layout binding.** Frames keep `,ihbb` exactly and name no layout: a frame's layout is
+//!   the latest `/mocap/labels` from the same source address whose marker count equals the
+//!   frame's ([`LayoutBook`]). A source may send layouts of different sizes; same-size layouts
+//!   replace each other, so a source with two same-size layouts must use two ports. Frames with
+//!   no matching layout are counted and dropped by the daemon until the labels arrive.
+//! - **Compact profile.** One bundle, time tag "immediately": the `,ihbb` frame then
+//!   `/emoshift/state ,sf`. Atomic in one datagram (1,424 bytes for 109 markers and the target
+//!   `neutral`); fits 1,472 bytes for target names up to 55 bytes.
+//! - **Components profile.** Without VMC labels, the bare `/emoshift/components` message;
+//!   with labels, one bundle: components, the `Val`s, then `Apply`.
+//! - **Flat-split.** Parts carry the frame's marker count so a receiver knows when it has all.
+//! - **Status reply.** `/status/confirm` carries `(s name, h value)` pairs; names are the
+//!   daemon's (e.g. `frames_in`, `frames_dropped`, one per [`DecodeErrorKind::as_str`]).
+//!
+//! # Decoding
+//!
+//! Every datagram first goes through [`messages`]: a pre-scan that allocates nothing, rejects
+//! datagrams over [`Limits::max_datagram`] (65,507 by default), bundles nested deeper than
+//! [`Limits::max_bundle_depth`] (8) — rosc recurses per bundle and aborts the process on
+//! deep nesting — and any truncation, trailing byte, bad element size or unknown type tag;
+//! then it yields the messages, bundles flattened. Frames are decoded by a borrowed parser
+//! into a caller [`FrameBuf`] ([`decode_frame_into`], no allocation; cross-checked against
+//! rosc by property tests). Labels and control go through rosc ([`decode_labels`],
+//! [`decode_control`]). Every failure is a [`DecodeError`] (small, `Copy`, with a
+//! [`DecodeErrorKind`] for counters) or a [`ControlError`] for control; nothing panics.
+//!
+//! ```
+//! use protocol::{decode_frame_into, encode_frame_into, messages, Address, FrameBuf, Limits};
+//!
+//! let mut frame = FrameBuf::with_max_markers(200);
+//! let nan = f32::NAN;
+//! frame.set_frame(7, 1_000, &[1.0, 2.0, 3.0, nan, nan, nan]).expect("valid frame");
+//! let mut datagram = Vec::with_capacity(1_500);
+//! encode_frame_into(&frame, &mut datagram).expect("finite positions");
+//!
+//! let mut received = FrameBuf::with_max_markers(200);
+//! for msg in messages(&datagram, &Limits::default()).expect("well-formed") {
+//!     if Address::parse(msg.address) == Some(Address::Frame) {
+//!         let header = decode_frame_into(msg.bytes, &mut received).expect("valid frame");
+//!         assert_eq!((header.frame_number, header.marker_count, header.missing_count), (7, 2, 1));
+//!         assert!(received.is_missing(1));
+//!     }
+//! }
+//! ```
 #![warn(missing_docs)]
+#![forbid(unsafe_code)]
+
+pub mod address;
+mod control;
+mod error;
+mod frame;
+mod labels;
+mod output;
+mod reply;
+mod scan;
+mod wire;
+
+pub use address::Address;
+pub use control::{decode_control, decode_osc, Control, ControlError, Profile};
+pub use error::{DecodeError, DecodeErrorKind, EncodeError};
+pub use frame::{
+    decode_frame_into, encode_frame_flat_into, encode_frame_into, frame_message_len, FrameBuf,
+    FrameForm, FrameHeader, MAX_FRAME_MARKERS,
+};
+pub use labels::{
+    decode_labels, encode_labels_into, Labels, LayoutBook, LayoutChange, MAX_LAYOUTS_PER_SOURCE,
+};
+pub use output::{
+    decode_components_into, decode_part_into, encode_compact_into, encode_components_into,
+    FlatSplit, PartHeader, ETHERNET_PAYLOAD,
+};
+pub use reply::{
+    decode_reply, encode_confirm_into, encode_control_into, encode_error_into, encode_status_into,
+    Reply,
+};
+pub use rosc;
+pub use scan::{
+    check_datagram, messages, Limits, Message, Messages, TimeTag, BUNDLE_DEPTH_CAP,
+    DEFAULT_MAX_BUNDLE_DEPTH, MAX_ARRAY_DEPTH, MAX_UDP_PAYLOAD,
+};

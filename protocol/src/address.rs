@@ -1,0 +1,121 @@
+//! The address space: one constant per OSC address and [`Address`] to route on it.
+
+/// Input frame, `,ihbb` (blob form) or `,ih` + 3n `f` (flat form).
+pub const FRAME: &str = "/mocap/frame";
+/// Marker names of a layout, `,i s...`.
+pub const LABELS: &str = "/mocap/labels";
+/// One part of a flat-split output frame, `,iiii f...`.
+pub const PART: &str = "/mocap/part";
+/// Edit state in the compact profile, `,sf`.
+pub const STATE: &str = "/emoshift/state";
+/// Current component activations u, `,f...`.
+pub const COMPONENTS: &str = "/emoshift/components";
+/// VMC blend shape value, `,sf`.
+pub const VMC_BLEND_VAL: &str = "/VMC/Ext/Blend/Val";
+/// VMC "apply the values sent so far", no arguments.
+pub const VMC_BLEND_APPLY: &str = "/VMC/Ext/Blend/Apply";
+/// Error reply to a control message, `,ss` (address, message).
+pub const ERROR: &str = "/emoshift/error";
+/// Suffix appended to a control address for its success reply.
+pub const CONFIRM_SUFFIX: &str = "/confirm";
+
+/// Control: set the target emotion, `,s`.
+pub const EMOTION_TARGET: &str = "/emotion/target";
+/// Control: set the edit amount, `,f`.
+pub const EMOTION_AMOUNT: &str = "/emotion/amount";
+/// Control: set the ramp time in seconds, `,f`.
+pub const EMOTION_RAMP: &str = "/emotion/ramp";
+/// Control: raw translate of component i, `,if`.
+pub const EMOTION_ALPHA: &str = "/emotion/alpha";
+/// Control: gain of component i, `,if`.
+pub const COMPONENT_GAIN: &str = "/component/gain";
+/// Control: bypass on (non-zero) or off, `,i`.
+pub const BYPASS: &str = "/bypass";
+/// Control: subscribe the sender's host at a port to a profile, `,is`.
+pub const SUBSCRIBE: &str = "/subscribe";
+/// Control: unsubscribe the sender's host at a port, `,i`.
+pub const UNSUBSCRIBE: &str = "/unsubscribe";
+/// Control: load a model file, `,s`.
+pub const MODEL_LOAD: &str = "/model/load";
+/// Control: start recording to a path, `,s`.
+pub const RECORD_START: &str = "/record/start";
+/// Control: stop recording, no arguments.
+pub const RECORD_STOP: &str = "/record/stop";
+/// Control: ask for the counters, no arguments; answered by `/status/confirm`.
+pub const STATUS: &str = "/status";
+
+/// Every address this crate knows, for routing a [`crate::Message`] without string compares
+/// scattered through the caller.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Address {
+    /// [`FRAME`]
+    Frame,
+    /// [`LABELS`]
+    Labels,
+    /// [`PART`]
+    Part,
+    /// [`STATE`]
+    State,
+    /// [`COMPONENTS`]
+    Components,
+    /// [`VMC_BLEND_VAL`]
+    VmcBlendVal,
+    /// [`VMC_BLEND_APPLY`]
+    VmcBlendApply,
+    /// [`ERROR`]
+    Error,
+    /// One of the control addresses (decode it with [`crate::decode_control`]).
+    Control,
+    /// A control reply: `<control address>/confirm`.
+    Confirm,
+}
+
+const CONTROLS: [&str; 12] = [
+    EMOTION_TARGET,
+    EMOTION_AMOUNT,
+    EMOTION_RAMP,
+    EMOTION_ALPHA,
+    COMPONENT_GAIN,
+    BYPASS,
+    SUBSCRIBE,
+    UNSUBSCRIBE,
+    MODEL_LOAD,
+    RECORD_START,
+    RECORD_STOP,
+    STATUS,
+];
+
+impl Address {
+    /// Classifies an address; `None` for addresses outside the emoshift space.
+    pub fn parse(address: &str) -> Option<Address> {
+        Some(match address {
+            FRAME => Address::Frame,
+            LABELS => Address::Labels,
+            PART => Address::Part,
+            STATE => Address::State,
+            COMPONENTS => Address::Components,
+            VMC_BLEND_VAL => Address::VmcBlendVal,
+            VMC_BLEND_APPLY => Address::VmcBlendApply,
+            ERROR => Address::Error,
+            a if CONTROLS.contains(&a) => Address::Control,
+            a => match a.strip_suffix(CONFIRM_SUFFIX) {
+                Some(base) if CONTROLS.contains(&base) => Address::Confirm,
+                _ => return None,
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn routes_known_addresses_only() {
+        assert_eq!(Address::parse("/mocap/frame"), Some(Address::Frame));
+        assert_eq!(Address::parse("/status"), Some(Address::Control));
+        assert_eq!(Address::parse("/status/confirm"), Some(Address::Confirm));
+        assert_eq!(Address::parse("/mocap/frame/confirm"), None);
+        assert_eq!(Address::parse("/mocap/frames"), None);
+    }
+}

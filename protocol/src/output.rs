@@ -1,0 +1,277 @@
+//! Output profiles: compact, flat-split and components. All encode into a caller `Vec<u8>`
+//! (cleared, capacity reused) without other allocation.
+
+use crate::address::{COMPONENTS, PART, STATE, VMC_BLEND_APPLY, VMC_BLEND_VAL};
+use crate::error::{DecodeError, EncodeError};
+use crate::frame::{append_frame, FrameBuf};
+use crate::scan::read_head;
+use crate::wire::{self, pad4};
+
+/// Payload that fits one Ethernet frame: 1,500 - 20 (IPv4) - 8 (UDP).
+pub const ETHERNET_PAYLOAD: usize = 1_472;
+
+/// Encodes the compact profile: one bundle (time tag "immediately") holding the edited frame
+/// as `/mocap/frame ,ihbb` and then `/emoshift/state ,sf` (target emotion, current amount).
+/// A bundle keeps frame and state atomic in one datagram: 1,428 bytes for 109 markers and a
+/// target name of up to 11 bytes. Returns the encoded length.
+///
+/// # Errors
+/// [`EncodeError::NonFinite`] for a present marker that is not finite,
+/// [`EncodeError::NulInString`] for a NUL in `target`.
+pub fn encode_compact_into(
+    frame: &FrameBuf,
+    target: &str,
+    amount: f32,
+    out: &mut Vec<u8>,
+) -> Result<usize, EncodeError> {
+    out.clear();
+    wire::put_bundle_header(out);
+    let at = wire::begin_element(out);
+    append_frame(frame, out)?;
+    wire::end_element(out, at);
+    let at = wire::begin_element(out);
+    wire::put_str_unchecked(out, STATE);
+    wire::put_str_unchecked(out, ",sf");
+    if let Err(e) = wire::put_str(out, target) {
+        out.clear();
+        return Err(e);
+    }
+    wire::put_f32(out, amount);
+    wire::end_element(out, at);
+    Ok(out.len())
+}
+
+/// How a frame is cut into `/mocap/part ,iiii f...` messages: frame number, first marker,
+/// markers in this part, markers in the frame, then 3 floats a marker (NaN = missing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FlatSplit {
+    markers_per_part: usize,
+}
+
+/// Bytes of a part message with `k` markers.
+const fn part_len(k: usize) -> usize {
+    12 + pad4(1 + 4 + 3 * k + 1) + 16 + 12 * k
+}
+
+impl FlatSplit {
+    /// The split whose parts are at most `max_bytes` long ([`ETHERNET_PAYLOAD`] by default;
+    /// 4,096 for receivers with 4 KB buffers).
+    ///
+    /// # Errors
+    /// [`EncodeError::PartTooSmall`] if not even one marker fits.
+    pub fn new(max_bytes: usize) -> Result<FlatSplit, EncodeError> {
+        // part_len grows by 15 bytes a marker (+ padding); search down from an upper bound
+        let mut k = max_bytes / 15 + 1;
+        while k > 0 && part_len(k) > max_bytes {
+            k -= 1;
+        }
+        if k == 0 {
+            return Err(EncodeError::PartTooSmall { max: max_bytes });
+        }
+        Ok(FlatSplit {
+            markers_per_part: k,
+        })
+    }
+
+    /// Markers each part carries (the last may carry fewer).
+    pub fn markers_per_part(&self) -> usize {
+        self.markers_per_part
+    }
+
+    /// Parts needed for `markers` markers (at least 1, so that an empty frame is still sent).
+    pub fn part_count(&self, markers: usize) -> usize {
+        markers.div_ceil(self.markers_per_part).max(1)
+    }
+
+    /// Encodes part `part` of `frame` into `out` (cleared first). Returns the encoded length,
+    /// or 0 if `part` is past the last part.
+    pub fn encode_part_into(&self, frame: &FrameBuf, part: usize, out: &mut Vec<u8>) -> usize {
+        out.clear();
+        let n = frame.marker_count();
+        let first = part * self.markers_per_part;
+        if part >= self.part_count(n) {
+            return 0;
+        }
+        let count = self.markers_per_part.min(n - first);
+        wire::put_str_unchecked(out, PART);
+        out.extend_from_slice(b",iiii");
+        out.resize(out.len() + 3 * count, b'f');
+        out.push(0);
+        wire::pad_to4(out, 0);
+        let h = frame.header();
+        wire::put_i32(out, h.frame_number);
+        for v in [first, count, n] {
+            wire::put_i32(
+                out,
+                i32::try_from(v).expect("marker counts are bounded by FrameBuf"),
+            );
+        }
+        for &v in &frame.positions()[3 * first..3 * (first + count)] {
+            wire::put_f32(out, v);
+        }
+        out.len()
+    }
+}
+
+/// Header of a decoded `/mocap/part`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PartHeader {
+    /// Frame number.
+    pub frame_number: i32,
+    /// Index of the first marker in this part.
+    pub first_marker: usize,
+    /// Markers in this part.
+    pub marker_count: usize,
+    /// Markers in the whole frame.
+    pub total_markers: usize,
+}
+
+/// Decodes a `/mocap/part` into `positions[3 * first .. 3 * (first + count)]` (a frame-sized
+/// caller buffer), without allocating. NaN coordinates (missing markers) are kept.
+///
+/// # Errors
+/// [`DecodeError::WrongTypeTags`], [`DecodeError::WrongCount`] (float count vs marker count),
+/// [`DecodeError::OutOfRange`] (negative or inconsistent indices),
+/// [`DecodeError::TooManyMarkers`] (frame larger than `positions`), [`DecodeError::NonFinite`]
+/// (infinite coordinate), truncation and trailing bytes.
+pub fn decode_part_into(msg: &[u8], positions: &mut [f32]) -> Result<PartHeader, DecodeError> {
+    let (address, tags, mut r) = read_head(msg)?;
+    if address != PART {
+        return Err(DecodeError::UnknownAddress);
+    }
+    let Some(floats) = tags
+        .strip_prefix(b"iiii")
+        .filter(|f| f.iter().all(|&t| t == b'f'))
+    else {
+        return Err(DecodeError::WrongTypeTags);
+    };
+    let frame_number = r.i32()?;
+    let mut ints = [0usize; 3];
+    for (k, v) in ints.iter_mut().enumerate() {
+        *v = usize::try_from(r.i32()?).map_err(|_| DecodeError::OutOfRange { index: k + 1 })?;
+    }
+    let [first, count, total] = ints;
+    if floats.len() != 3 * count {
+        return Err(DecodeError::WrongCount {
+            expected: 3 * count,
+            got: floats.len(),
+        });
+    }
+    if first + count > total {
+        return Err(DecodeError::OutOfRange { index: 2 });
+    }
+    if 3 * total > positions.len() {
+        return Err(DecodeError::TooManyMarkers {
+            markers: total,
+            max: positions.len() / 3,
+        });
+    }
+    let coords = r.take(12 * count)?;
+    if r.remaining() != 0 {
+        return Err(DecodeError::TrailingBytes {
+            offset: r.pos(),
+            extra: r.remaining(),
+        });
+    }
+    let dst = &mut positions[3 * first..3 * (first + count)];
+    for (i, (c, d)) in coords.chunks_exact(4).zip(dst.iter_mut()).enumerate() {
+        *d = f32::from_be_bytes([c[0], c[1], c[2], c[3]]);
+        if d.is_infinite() {
+            return Err(DecodeError::NonFinite {
+                marker: first + i / 3,
+            });
+        }
+    }
+    Ok(PartHeader {
+        frame_number,
+        first_marker: first,
+        marker_count: count,
+        total_markers: total,
+    })
+}
+
+/// Encodes the components profile into `out` (cleared first). Returns the encoded length.
+///
+/// Without `vmc` labels: the bare message `/emoshift/components ,f...` carrying u. With
+/// labels: one bundle of that message, one `/VMC/Ext/Blend/Val ,sf` per (name, component
+/// index) label, and a closing `/VMC/Ext/Blend/Apply`, as VMC receivers expect values then
+/// apply in one datagram. Labels naming a component past `u` are skipped.
+///
+/// # Errors
+/// [`EncodeError::NulInString`] for a NUL in a label.
+pub fn encode_components_into<S: AsRef<str>>(
+    u: &[f32],
+    vmc: &[(S, usize)],
+    out: &mut Vec<u8>,
+) -> Result<usize, EncodeError> {
+    out.clear();
+    if vmc.is_empty() {
+        append_components(u, out);
+        return Ok(out.len());
+    }
+    wire::put_bundle_header(out);
+    let at = wire::begin_element(out);
+    append_components(u, out);
+    wire::end_element(out, at);
+    for (name, i) in vmc {
+        let Some(&value) = u.get(*i) else { continue };
+        let at = wire::begin_element(out);
+        wire::put_str_unchecked(out, VMC_BLEND_VAL);
+        wire::put_str_unchecked(out, ",sf");
+        if let Err(e) = wire::put_str(out, name.as_ref()) {
+            out.clear();
+            return Err(e);
+        }
+        wire::put_f32(out, value);
+        wire::end_element(out, at);
+    }
+    let at = wire::begin_element(out);
+    wire::put_str_unchecked(out, VMC_BLEND_APPLY);
+    wire::put_str_unchecked(out, ",");
+    wire::end_element(out, at);
+    Ok(out.len())
+}
+
+fn append_components(u: &[f32], out: &mut Vec<u8>) {
+    let start = out.len();
+    wire::put_str_unchecked(out, COMPONENTS);
+    out.push(b',');
+    out.resize(out.len() + u.len(), b'f');
+    out.push(0);
+    wire::pad_to4(out, start);
+    for &v in u {
+        wire::put_f32(out, v);
+    }
+}
+
+/// Decodes `/emoshift/components ,f...` into `u` without allocating; returns how many values.
+///
+/// # Errors
+/// [`DecodeError::WrongTypeTags`], [`DecodeError::TooManyMarkers`] (more values than `u`
+/// holds), truncation and trailing bytes.
+pub fn decode_components_into(msg: &[u8], u: &mut [f32]) -> Result<usize, DecodeError> {
+    let (address, tags, mut r) = read_head(msg)?;
+    if address != COMPONENTS {
+        return Err(DecodeError::UnknownAddress);
+    }
+    if !tags.iter().all(|&t| t == b'f') {
+        return Err(DecodeError::WrongTypeTags);
+    }
+    let n = tags.len();
+    if n > u.len() {
+        return Err(DecodeError::TooManyMarkers {
+            markers: n,
+            max: u.len(),
+        });
+    }
+    for v in &mut u[..n] {
+        *v = r.f32()?;
+    }
+    if r.remaining() != 0 {
+        return Err(DecodeError::TrailingBytes {
+            offset: r.pos(),
+            extra: r.remaining(),
+        });
+    }
+    Ok(n)
+}
