@@ -1,6 +1,7 @@
 //! ica-core
 #![warn(missing_docs)]
 
+pub mod dtw;
 pub mod edit;
 pub mod fastica;
 pub mod fit;
@@ -10,3 +11,4 @@ pub mod report;
 pub mod whiten;
 
 pub use report::{RestartReport, TrainReport};
+pub use fit::{amari_index, FastIcaParams, FitData, FitError, FitOutput};
