@@ -1,0 +1,291 @@
+//! Line and cell primitives shared by the two text formats (TRC here, CSV in `crate::csv`).
+//!
+//! They live under `trc` only because a module of the text formats' own would sit outside the
+//! paths these readers own; nothing here is TRC specific.
+
+use std::io::BufRead;
+
+use crate::error::{ReadError, WriteError};
+
+/// Reads a text file line by line, numbering lines from 1 and stripping `\n` or `\r\n`.
+///
+/// Lines are read as bytes and checked for UTF-8 here, so a bad byte is reported with its line
+/// number instead of as an anonymous I/O error.
+#[derive(Debug)]
+pub(crate) struct Lines<R> {
+    input: R,
+    text: String,
+    number: usize,
+}
+
+impl<R: BufRead> Lines<R> {
+    /// Wraps a buffered reader positioned at the start of the file.
+    pub(crate) fn new(input: R) -> Self {
+        Lines {
+            input,
+            text: String::new(),
+            number: 0,
+        }
+    }
+
+    /// Number of the next line [`Lines::next_line`] would return.
+    pub(crate) fn next_number(&self) -> usize {
+        self.number + 1
+    }
+
+    /// The next line with its 1-based number, or `None` at the end of input.
+    ///
+    /// # Errors
+    /// I/O failure or a line that is not UTF-8.
+    pub(crate) fn next_line(&mut self) -> Result<Option<(usize, &str)>, ReadError> {
+        // Reuse the previous line's allocation for the raw bytes.
+        let mut bytes = std::mem::take(&mut self.text).into_bytes();
+        bytes.clear();
+        if self.input.read_until(b'\n', &mut bytes)? == 0 {
+            return Ok(None);
+        }
+        self.number += 1;
+        if bytes.last() == Some(&b'\n') {
+            bytes.pop();
+        }
+        if bytes.last() == Some(&b'\r') {
+            bytes.pop();
+        }
+        self.text =
+            String::from_utf8(bytes).map_err(|_| ReadError::NotUtf8 { line: self.number })?;
+        Ok(Some((self.number, &self.text)))
+    }
+
+    /// The next line that holds anything but whitespace, or `None` at the end of input.
+    ///
+    /// # Errors
+    /// As [`Lines::next_line`].
+    pub(crate) fn next_non_blank(&mut self) -> Result<Option<(usize, &str)>, ReadError> {
+        loop {
+            // Two lookups because returning the borrow from inside the loop would keep `self`
+            // borrowed across iterations.
+            match self.next_line()? {
+                None => return Ok(None),
+                Some((_, line)) if line.trim().is_empty() => continue,
+                Some(_) => return Ok(Some((self.number, &self.text))),
+            }
+        }
+    }
+}
+
+/// What a sample cell may hold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Sample {
+    /// Empty or `NaN`: the marker is missing in this frame.
+    Missing,
+    /// A finite number, in the file's units.
+    Value(f64),
+}
+
+/// What a sample cell must hold, for error messages.
+pub(crate) const EXPECTED_SAMPLE: &str = "a finite number, an empty cell or NaN";
+
+/// Parses a sample cell: blank and `NaN` (any case) mean missing; anything else must be a finite
+/// number. Surrounding spaces are ignored.
+///
+/// # Errors
+/// The text to report for a non-numeric or infinite cell (the caller knows line and column).
+pub(crate) fn parse_sample(cell: &str) -> Result<Sample, &'static str> {
+    let cell = cell.trim();
+    if cell.is_empty() {
+        return Ok(Sample::Missing);
+    }
+    match cell.parse::<f64>() {
+        Ok(v) if v.is_nan() => Ok(Sample::Missing),
+        Ok(v) if v.is_finite() => Ok(Sample::Value(v)),
+        _ => Err(EXPECTED_SAMPLE),
+    }
+}
+
+/// Parses a frame number: an integer, or a number with no fractional part (`12.0`), which some
+/// exporters write.
+pub(crate) fn parse_frame_number(cell: &str) -> Option<i64> {
+    let cell = cell.trim();
+    if let Ok(n) = cell.parse::<i64>() {
+        return Some(n);
+    }
+    let v = cell.parse::<f64>().ok()?;
+    // The bounds keep the cast exact; frame numbers this large are not real data.
+    (v.fract() == 0.0 && v.abs() < 9.0e15).then_some(v as i64)
+}
+
+/// Parses a time cell: a finite number of seconds.
+pub(crate) fn parse_time(cell: &str) -> Option<f64> {
+    cell.trim().parse::<f64>().ok().filter(|t| t.is_finite())
+}
+
+/// Checks that a row's frame number follows the previous one, and returns it.
+///
+/// # Errors
+/// [`ReadError::BadCell`] for a non-integer, [`ReadError::FrameGap`] for a skipped or repeated
+/// frame. Gaps are errors rather than filled with missing samples because a hole in the numbering
+/// usually means a damaged or hand-edited file, and the take's time axis is the row order.
+pub(crate) fn check_frame_number(
+    cell: &str,
+    line: usize,
+    expected: Option<i64>,
+    field: &str,
+) -> Result<i64, ReadError> {
+    let found = parse_frame_number(cell).ok_or_else(|| ReadError::BadCell {
+        line,
+        column: 1,
+        field: field.to_owned(),
+        expected: "an integer frame number",
+        found: cell.to_owned(),
+    })?;
+    match expected {
+        Some(expected) if expected != found => Err(ReadError::FrameGap {
+            line,
+            expected,
+            found,
+        }),
+        _ => Ok(found),
+    }
+}
+
+/// Parses a row's sample cells into `xyz` (mm) and `gone` (one flag per marker). `cells` may be
+/// shorter than `xyz`: absent cells mean missing. `first_column` is the 0-based column of
+/// `cells[0]` in the row, for error messages.
+///
+/// # Errors
+/// [`ReadError::BadCell`] naming line, column and `<label> <axis>` for text, infinity, or a value
+/// that overflows `f32` once scaled to millimetres.
+pub(crate) fn parse_samples(
+    line: usize,
+    cells: &[&str],
+    first_column: usize,
+    labels: &[String],
+    scale_to_mm: f64,
+    xyz: &mut [f32],
+    gone: &mut [bool],
+) -> Result<(), ReadError> {
+    gone.fill(false);
+    for (i, value) in xyz.iter_mut().enumerate() {
+        let cell = cells.get(i).copied().unwrap_or("");
+        let field = || format!("{} {}", labels[i / 3], ["x", "y", "z"][i % 3]);
+        match parse_sample(cell) {
+            Ok(Sample::Missing) => {
+                gone[i / 3] = true;
+                *value = 0.0;
+            }
+            Ok(Sample::Value(v)) => {
+                *value = (v * scale_to_mm) as f32;
+                if !value.is_finite() {
+                    let expected = "a coordinate within f32 range";
+                    return Err(bad_cell(line, first_column + i, &field(), expected, cell));
+                }
+            }
+            Err(expected) => {
+                return Err(bad_cell(line, first_column + i, &field(), expected, cell));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A [`ReadError::BadCell`] from a 0-based `column`.
+pub(crate) fn bad_cell(
+    line: usize,
+    column: usize,
+    field: &str,
+    expected: &'static str,
+    found: &str,
+) -> ReadError {
+    ReadError::BadCell {
+        line,
+        column: column + 1,
+        field: field.to_owned(),
+        expected,
+        found: found.to_owned(),
+    }
+}
+
+/// Formats a sample cell for writing: the shortest text that reads back to the same `f32`, so
+/// round trips are exact and files stay compact.
+pub(crate) fn push_sample(out: &mut String, value: f32) {
+    use std::fmt::Write as _;
+    write!(out, "{value}").expect("writing to a String cannot fail");
+}
+
+/// Rejects labels holding a character the format uses as a separator, before anything is
+/// written, so a bad take never leaves half a file behind.
+///
+/// # Errors
+/// [`WriteError::LabelUnrepresentable`] naming the first offending label and character.
+pub(crate) fn check_labels(
+    labels: &[String],
+    format: &'static str,
+    forbidden: &[char],
+) -> Result<(), WriteError> {
+    for label in labels {
+        if let Some(c) = label.chars().find(|c| forbidden.contains(c)) {
+            return Err(WriteError::LabelUnrepresentable {
+                format,
+                label: label.clone(),
+                forbidden: c,
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // a failed unwrap is a failed test
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_blank_nan_number_and_rejects() {
+        assert_eq!(parse_sample(""), Ok(Sample::Missing));
+        assert_eq!(parse_sample("  "), Ok(Sample::Missing));
+        assert_eq!(parse_sample("NaN"), Ok(Sample::Missing));
+        assert_eq!(parse_sample("nan"), Ok(Sample::Missing));
+        assert_eq!(parse_sample(" -1.5e2 "), Ok(Sample::Value(-150.0)));
+        assert!(parse_sample("inf").is_err());
+        assert!(parse_sample("-Infinity").is_err());
+        assert!(parse_sample("1.2.3").is_err());
+        assert!(parse_sample("abc").is_err());
+    }
+
+    #[test]
+    fn frame_numbers_accept_integral_floats_only() {
+        assert_eq!(parse_frame_number("12"), Some(12));
+        assert_eq!(parse_frame_number("-3"), Some(-3));
+        assert_eq!(parse_frame_number("12.0"), Some(12));
+        assert_eq!(parse_frame_number("12.5"), None);
+        assert_eq!(parse_frame_number("x"), None);
+        assert_eq!(parse_frame_number("1e300"), None);
+    }
+
+    #[test]
+    fn lines_strip_crlf_and_number_from_one() {
+        let mut lines = Lines::new("a\r\n\r\n  \nb".as_bytes());
+        assert_eq!(lines.next_line().unwrap(), Some((1, "a")));
+        assert_eq!(lines.next_non_blank().unwrap(), Some((4, "b")));
+        assert_eq!(lines.next_line().unwrap(), None);
+    }
+
+    #[test]
+    fn lines_report_bad_utf8_with_its_line() {
+        let mut lines = Lines::new(&b"ok\n\xff\xfe\n"[..]);
+        assert!(lines.next_line().unwrap().is_some());
+        match lines.next_line() {
+            Err(ReadError::NotUtf8 { line }) => assert_eq!(line, 2),
+            other => panic!("expected NotUtf8, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn written_samples_read_back_exactly() {
+        for v in [0.0f32, -0.1, 143.5201, 1234.5679, 1.0e-7, -98765.43] {
+            let mut s = String::new();
+            push_sample(&mut s, v);
+            assert_eq!(s.parse::<f32>().unwrap(), v, "{s}");
+        }
+    }
+}

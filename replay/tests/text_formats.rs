@@ -1,0 +1,489 @@
+//! TRC and CSV: real files, round trips, and a typed error for each kind of damage.
+#![allow(clippy::unwrap_used)] // a failed unwrap is a failed test
+
+use std::path::{Path, PathBuf};
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use replay::{csv, trc, Format, ReadError, Take, Units, WriteError};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(name)
+}
+
+/// Three frames, two markers, numbered from 10; data rows are lines 7-9.
+const SMALL_TRC: &str = "PathFileType\t4\t(X/Y/Z)\tsmall.trc\n\
+DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames\n\
+100\t100\t3\t2\tmm\t100\t10\t3\n\
+Frame#\tTime\tNose Tip\t\t\tChin\t\t\t\n\
+\t\tX1\tY1\tZ1\tX2\tY2\tZ2\n\
+\n\
+10\t0.00\t1\t2\t3\t4\t5\t6\n\
+11\t0.01\t1.5\t2.5\t3.5\t4.5\t5.5\t6.5\n\
+12\t0.02\t2\t3\t4\t5\t6\t7\n";
+
+/// The same take as CSV, without a rate comment; data rows are lines 2-4.
+const SMALL_CSV: &str = "frame,time,Nose Tip_x,Nose Tip_y,Nose Tip_z,Chin_x,Chin_y,Chin_z\n\
+10,0.00,1,2,3,4,5,6\n\
+11,0.01,1.5,2.5,3.5,4.5,5.5,6.5\n\
+12,0.02,2,3,4,5,6,7\n";
+
+fn read_trc(text: &str) -> Result<Take, ReadError> {
+    trc::read(text.as_bytes())
+}
+
+fn read_csv(text: &str) -> Result<Take, ReadError> {
+    csv::read(text.as_bytes())
+}
+
+/// `SMALL_TRC` with one data row (frame 10, 11 or 12) replaced.
+fn trc_with_row(frame: i64, row: &str) -> String {
+    let prefix = format!("{frame}\t");
+    SMALL_TRC
+        .lines()
+        .map(|l| if l.starts_with(&prefix) { row } else { l })
+        .map(|l| format!("{l}\n"))
+        .collect()
+}
+
+#[test]
+fn real_excerpt_loads_through_format_dispatch() {
+    let take = replay::load(&fixture("NoseMoCap_first60.trc")).unwrap();
+    assert_eq!((take.n_frames(), take.n_markers()), (60, 41));
+    assert_eq!((take.rate_hz, take.first_frame), (60.0, 1));
+    assert_eq!(take.source_units, Units::Millimetres);
+    assert_eq!(take.labels[0], "ForeHead_M");
+    assert_eq!(take.labels[40], "Chin_L2");
+    assert!(take.missing.iter().all(|&m| !m));
+    // First and last row of the excerpt, as printed in the file.
+    assert_eq!(take.sample(0, 0), Some([143.5201, 842.2137, 29.0542]));
+    assert_eq!(take.sample(59, 0), Some([141.1453, 840.4015, 36.6570]));
+}
+
+#[test]
+fn animface_takes_load_with_their_documented_frame_counts() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/animface-rom");
+    if !dir.exists() {
+        eprintln!(
+            "{} absent: only the committed excerpt is checked",
+            dir.display()
+        );
+        return;
+    }
+    let expected = [
+        ("CheeksMoCap.trc", 1499),
+        ("EyebrowsMoCap.trc", 902),
+        ("JawMoCap.trc", 1590),
+        ("NoseMoCap.trc", 962),
+    ];
+    for (name, frames) in expected {
+        let take = replay::load(&dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(take.n_frames(), frames, "{name}");
+        assert_eq!(
+            (take.n_markers(), take.rate_hz, take.first_frame),
+            (41, 60.0, 1),
+            "{name}"
+        );
+        assert!(take.missing.iter().all(|&m| !m), "{name} has gaps");
+    }
+    // A whole real take survives both writers exactly.
+    let nose = replay::load(&dir.join("NoseMoCap.trc")).unwrap();
+    for format in [Format::Trc, Format::Csv] {
+        let mut bytes = Vec::new();
+        replay::write_as(format, &nose, &mut bytes).unwrap();
+        let back = match format {
+            Format::Trc => trc::read(&bytes[..]),
+            _ => csv::read(&bytes[..]),
+        };
+        assert_eq!(back.unwrap(), nose, "{format:?}");
+    }
+}
+
+/// A seeded take with awkward labels, ~10% gaps, a fully missing frame, a last marker missing in
+/// the last frame, a first frame far from 1 and an NTSC rate.
+fn random_take(seed: u64, frames: usize) -> Take {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let labels = ["Lip Upper", "Brow_L_inner", "Chin", "ear-R (2)"];
+    let mut take = Take::new(labels.map(String::from).to_vec(), 120_000.0 / 1001.0, -37);
+    let n = labels.len();
+    for f in 0..frames {
+        let xyz: Vec<f32> = (0..3 * n)
+            .map(|_| rng.random_range(-2000.0..2000.0))
+            .collect();
+        let mut gone: Vec<bool> = (0..n).map(|_| rng.random_bool(0.1)).collect();
+        if f == 3 {
+            gone.fill(true);
+        }
+        if f == frames - 1 {
+            gone[n - 1] = true;
+        }
+        take.push_frame(&xyz, &gone);
+    }
+    take
+}
+
+#[test]
+fn trc_round_trip_is_exact_with_gaps_and_odd_numbering() {
+    let take = random_take(7, 50);
+    let mut bytes = Vec::new();
+    trc::write(&take, &mut bytes).unwrap();
+    let back = trc::read(&bytes[..]).unwrap();
+    assert_eq!(back, take);
+    // Missing samples are empty cells: frame 3 (line 10) has nothing after its time.
+    let text = String::from_utf8(bytes).unwrap();
+    let row = text.lines().nth(9).unwrap();
+    assert!(row.starts_with("-34\t0.025025\t\t\t"), "{row:?}");
+}
+
+#[test]
+fn csv_round_trip_is_exact_and_keeps_rate_of_a_single_frame() {
+    for frames in [50, 1] {
+        let take = random_take(11, frames.max(5));
+        let take = if frames == 1 {
+            first_frames(&take, 1)
+        } else {
+            take
+        };
+        let mut bytes = Vec::new();
+        csv::write(&take, &mut bytes).unwrap();
+        assert_eq!(csv::read(&bytes[..]).unwrap(), take, "{frames} frame(s)");
+    }
+}
+
+fn first_frames(take: &Take, frames: usize) -> Take {
+    let mut out = Take::new(take.labels.clone(), take.rate_hz, take.first_frame);
+    for f in 0..frames {
+        out.push_frame(take.frame(f), take.frame_missing(f));
+    }
+    out
+}
+
+#[test]
+fn writers_emit_the_documented_layouts() {
+    let mut take = Take::new(vec!["A b".into(), "C_d".into()], 120.0, 5);
+    take.push_frame(&[1.0, 2.5, -3.0, 0.1, 0.2, 0.3], &[false, true]);
+    take.push_frame(&[1.25, 2.0, 3.0, 10.0, 20.0, 30.0], &[false, false]);
+    let mut trc_out = Vec::new();
+    trc::write(&take, &mut trc_out).unwrap();
+    let expected_trc = "PathFileType\t4\t(X/Y/Z)\ttake.trc\n\
+DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames\n\
+120\t120\t2\t2\tmm\t120\t5\t2\n\
+Frame#\tTime\tA b\t\t\tC_d\t\t\n\
+\t\tX1\tY1\tZ1\tX2\tY2\tZ2\n\
+\n\
+5\t0.000000\t1\t2.5\t-3\t\t\t\n\
+6\t0.008333\t1.25\t2\t3\t10\t20\t30\n";
+    assert_eq!(String::from_utf8(trc_out).unwrap(), expected_trc);
+    let mut csv_out = Vec::new();
+    csv::write(&take, &mut csv_out).unwrap();
+    let expected_csv = "# rate_hz=120 units=mm\n\
+frame,time,A b_x,A b_y,A b_z,C_d_x,C_d_y,C_d_z\n\
+5,0.000000,1,2.5,-3,,,\n\
+6,0.008333,1.25,2,3,10,20,30\n";
+    assert_eq!(String::from_utf8(csv_out).unwrap(), expected_csv);
+}
+
+#[test]
+fn csv_rate_is_derived_from_time_when_not_declared() {
+    let take = read_csv(SMALL_CSV).unwrap();
+    assert_eq!(
+        (take.rate_hz, take.first_frame, take.n_frames()),
+        (100.0, 10, 3)
+    );
+    // 120 Hz written with 6 decimals (0.008333 steps) still comes back as exactly 120.
+    let mut bytes = Vec::new();
+    csv::write(&random_take(3, 2), &mut bytes).unwrap();
+    let text = String::from_utf8(bytes)
+        .unwrap()
+        .replace("# rate_hz=119.88011988011988 ", "# ");
+    assert_eq!(read_csv(&text).unwrap().rate_hz, 120_000.0 / 1001.0);
+    let one_frame: String = SMALL_CSV
+        .lines()
+        .take(2)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(matches!(
+        read_csv(&one_frame),
+        Err(ReadError::NoRate { frames: 1 })
+    ));
+    let stalled = SMALL_CSV.replace("11,0.01,", "11,0.00,");
+    let err = read_csv(&stalled).unwrap_err();
+    assert!(
+        matches!(err, ReadError::UnevenTime { line: 3, .. }),
+        "{err}"
+    );
+}
+
+#[test]
+fn csv_comment_units_convert_to_mm() {
+    let text = format!("# rate_hz=50 units=cm\n{SMALL_CSV}");
+    let take = read_csv(&text).unwrap();
+    assert_eq!(
+        (take.rate_hz, take.source_units),
+        (50.0, Units::Centimetres)
+    );
+    assert_eq!(take.sample(1, 0), Some([15.0, 25.0, 35.0]));
+}
+
+#[test]
+fn trc_units_convert_to_mm_and_unknown_units_are_rejected() {
+    let take = read_trc(&SMALL_TRC.replace("\tmm\t", "\tm\t")).unwrap();
+    assert_eq!(take.source_units, Units::Metres);
+    assert_eq!(take.sample(1, 1), Some([4500.0, 5500.0, 6500.0]));
+    let err = read_trc(&SMALL_TRC.replace("\tmm\t", "\tinches\t")).unwrap_err();
+    assert!(
+        matches!(&err, ReadError::UnknownUnits(u) if u == "inches"),
+        "{err}"
+    );
+}
+
+#[test]
+fn truncated_trc_names_both_frame_counts() {
+    let text = std::fs::read_to_string(fixture("NoseMoCap_first60.trc")).unwrap();
+    let cut: String = text
+        .lines()
+        .take(6 + 55)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let err = read_trc(&cut).unwrap_err();
+    assert!(matches!(
+        err,
+        ReadError::FrameCountMismatch {
+            declared: 60,
+            found: 55
+        }
+    ));
+    assert_eq!(
+        err.to_string(),
+        "header declares 60 frames but the data holds 55"
+    );
+    // A header that undercounts is rejected too rather than guessed around.
+    let extra = format!("{SMALL_TRC}13\t0.03\t1\t2\t3\t4\t5\t6\n");
+    assert!(matches!(
+        read_trc(&extra),
+        Err(ReadError::FrameCountMismatch {
+            declared: 3,
+            found: 4
+        })
+    ));
+}
+
+#[test]
+fn trc_row_cut_inside_a_marker_is_a_truncated_row() {
+    let text = std::fs::read_to_string(fixture("NoseMoCap_first60.trc")).unwrap();
+    let last = text.lines().last().unwrap();
+    // Keep frame, time, marker 1 and the x of marker 2: cut just before marker 2's y.
+    let keep: Vec<&str> = last.split('\t').take(6).collect();
+    let cut = text.replace(last, &keep.join("\t"));
+    let err = read_trc(&cut).unwrap_err();
+    match &err {
+        ReadError::TruncatedRow {
+            line,
+            marker,
+            cells,
+        } => {
+            assert_eq!((*line, marker.as_str(), *cells), (66, "ForeHead_L", 1));
+        }
+        other => panic!("expected TruncatedRow, got {other}"),
+    }
+}
+
+#[test]
+fn trc_short_rows_trailing_tabs_crlf_and_no_blank_line_are_tolerated() {
+    let text = trc_with_row(11, "11\t0.01\t1.5\t2.5\t3.5");
+    let take = read_trc(&text).unwrap();
+    assert_eq!(take.frame_missing(1), [false, true]);
+    let text = trc_with_row(11, "11\t0.01\t1.5\t2.5\t3.5\t4.5\t5.5\t6.5\t\t");
+    assert_eq!(read_trc(&text).unwrap(), read_trc(SMALL_TRC).unwrap());
+    let crlf = SMALL_TRC.replace("\n\n", "\n").replace('\n', "\r\n");
+    assert_eq!(read_trc(&crlf).unwrap(), read_trc(SMALL_TRC).unwrap());
+}
+
+#[test]
+fn nan_and_blank_cells_mean_missing_in_both_formats() {
+    let take = read_trc(&trc_with_row(12, "12\t0.02\tNaN\t3\t4\t5\t\t7")).unwrap();
+    assert_eq!(take.frame_missing(2), [true, true]);
+    assert_eq!(take.sample(2, 0), None);
+    let take = read_csv(&SMALL_CSV.replace("12,0.02,2,3,4", "12,0.02,2,nan,4")).unwrap();
+    assert_eq!(take.frame_missing(2), [true, false]);
+}
+
+#[test]
+fn bad_cells_name_line_column_and_marker() {
+    let cases = [
+        (
+            read_trc(&trc_with_row(11, "11\t0.01\t1.5\t2.5\t3.5\t4.5\tabc\t6.5")),
+            8,
+            7,
+            "Chin y",
+        ),
+        (
+            read_trc(&trc_with_row(12, "12\t0.02\t2\t3\tinf\t5\t6\t7")),
+            9,
+            5,
+            "Nose Tip z",
+        ),
+        (
+            read_trc(&trc_with_row(11, "11\tsoon\t1\t2\t3\t4\t5\t6")),
+            8,
+            2,
+            "Time",
+        ),
+        (
+            read_trc(&trc_with_row(11, "x1\t0.01\t1\t2\t3\t4\t5\t6")),
+            8,
+            1,
+            "Frame#",
+        ),
+        (
+            read_csv(&SMALL_CSV.replace("5.5", "-Infinity")),
+            3,
+            7,
+            "Chin y",
+        ),
+        (
+            read_csv(&SMALL_CSV.replace("1.5,2.5", "1.5,2..5")),
+            3,
+            4,
+            "Nose Tip y",
+        ),
+    ];
+    for (result, want_line, want_column, want_field) in cases {
+        match result {
+            Err(ReadError::BadCell {
+                line,
+                column,
+                field,
+                ..
+            }) => assert_eq!(
+                (line, column, field.as_str()),
+                (want_line, want_column, want_field)
+            ),
+            other => panic!("expected BadCell at {want_line}:{want_column}, got {other:?}"),
+        }
+    }
+    let err = read_trc(&trc_with_row(12, "12\t0.02\t2\t3\tinf\t5\t6\t7")).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "line 9, column 5 (Nose Tip z): expected a finite number, an empty cell or NaN, found \"inf\""
+    );
+}
+
+#[test]
+fn wrong_column_counts_and_frame_gaps_are_typed_errors() {
+    let long = trc_with_row(11, "11\t0.01\t1\t2\t3\t4\t5\t6\t7");
+    assert!(matches!(
+        read_trc(&long),
+        Err(ReadError::ColumnCount {
+            line: 8,
+            expected: 8,
+            found: 9
+        })
+    ));
+    let short = SMALL_CSV.replace("11,0.01,1.5,2.5,3.5,4.5,5.5,6.5", "11,0.01,1.5,2.5,3.5");
+    assert!(matches!(
+        read_csv(&short),
+        Err(ReadError::ColumnCount {
+            line: 3,
+            expected: 8,
+            found: 5
+        })
+    ));
+    let gap = trc_with_row(11, "13\t0.01\t1\t2\t3\t4\t5\t6");
+    assert!(matches!(
+        read_trc(&gap),
+        Err(ReadError::FrameGap {
+            line: 8,
+            expected: 11,
+            found: 13
+        })
+    ));
+    let gap = SMALL_CSV.replace("\n12,", "\n11,");
+    assert!(matches!(
+        read_csv(&gap),
+        Err(ReadError::FrameGap {
+            line: 4,
+            expected: 12,
+            found: 11
+        })
+    ));
+    let bad_header = SMALL_CSV.replace("Chin_y", "Chim_y");
+    assert!(matches!(
+        read_csv(&bad_header),
+        Err(ReadError::BadCell {
+            line: 1,
+            column: 7,
+            ..
+        })
+    ));
+}
+
+#[test]
+fn labels_a_format_cannot_hold_are_refused_before_writing() {
+    let mut take = Take::new(vec!["ok".into(), "a,b".into()], 60.0, 1);
+    take.push_frame(&[0.0; 6], &[false, false]);
+    let mut out = Vec::new();
+    let err = csv::write(&take, &mut out).unwrap_err();
+    assert!(
+        matches!(err, WriteError::LabelUnrepresentable { forbidden: ',', .. }),
+        "{err}"
+    );
+    assert!(out.is_empty());
+    // The comma is fine in TRC; a tab is not.
+    trc::write(&take, &mut out).unwrap();
+    take.labels[1] = "a\tb".into();
+    out.clear();
+    let err = trc::write(&take, &mut out).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            WriteError::LabelUnrepresentable {
+                forbidden: '\t',
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(out.is_empty());
+}
+
+/// Damaged files of every shape return an error or a valid take, never panic.
+#[test]
+fn damaged_input_never_panics() {
+    let mut rng = ChaCha8Rng::seed_from_u64(2024);
+    let mut csv_bytes = Vec::new();
+    csv::write(&random_take(5, 6), &mut csv_bytes).unwrap();
+    let sources = [
+        SMALL_TRC.as_bytes().to_vec(),
+        SMALL_CSV.as_bytes().to_vec(),
+        csv_bytes,
+    ];
+    let noise = [
+        b'\t', b',', b'\n', b'\r', b'#', b'-', b'.', b'e', b'9', 0xff, b'_', b' ',
+    ];
+    for round in 0..600 {
+        let mut bytes = sources[round % 3].clone();
+        for _ in 0..rng.random_range(1..4) {
+            if bytes.is_empty() {
+                break;
+            }
+            let at = rng.random_range(0..bytes.len());
+            match rng.random_range(0..4) {
+                0 => bytes[at] = noise[rng.random_range(0..noise.len())],
+                1 => {
+                    bytes.remove(at);
+                }
+                2 => bytes.insert(at, noise[rng.random_range(0..noise.len())]),
+                _ => bytes.truncate(at.max(1)),
+            }
+        }
+        for take in [trc::read(&bytes[..]), csv::read(&bytes[..])]
+            .into_iter()
+            .flatten()
+        {
+            take.validate().unwrap();
+        }
+    }
+}
