@@ -53,6 +53,10 @@ impl<R: BufRead> Lines<R> {
         }
         self.text =
             String::from_utf8(bytes).map_err(|_| ReadError::NotUtf8 { line: self.number })?;
+        // Spreadsheet and Windows exporters often start files with a UTF-8 byte order mark.
+        if self.number == 1 && self.text.starts_with('\u{feff}') {
+            self.text.drain(..'\u{feff}'.len_utf8());
+        }
         Ok(Some((self.number, &self.text)))
     }
 
@@ -268,6 +272,9 @@ mod tests {
         assert_eq!(lines.next_line().unwrap(), Some((1, "a")));
         assert_eq!(lines.next_non_blank().unwrap(), Some((4, "b")));
         assert_eq!(lines.next_line().unwrap(), None);
+        let mut bom = Lines::new("\u{feff}frame,time\n\u{feff}x".as_bytes());
+        assert_eq!(bom.next_line().unwrap(), Some((1, "frame,time")));
+        assert_eq!(bom.next_line().unwrap(), Some((2, "\u{feff}x")));
     }
 
     #[test]
