@@ -1,0 +1,484 @@
+//! Head stabilisation: remove each frame's rigid head motion before modelling the face, and put
+//! it back after editing.
+//!
+//! A set of rigid reference markers (forehead, nose bridge, head band...) is chosen by label or
+//! automatically ([`choose_reference`]: the set whose pairwise distances vary least). From the
+//! training frames a reference shape, the *template*, is built by generalised Procrustes
+//! averaging. Each frame's pose is then the rigid transform (Kabsch) that best maps the template
+//! onto the reference markers present in that frame: `world = R · head + t`.
+//!
+//! Per frame everything is stack-allocated (3 x 3 SVD), so [`Stabiliser::estimate`] and the two
+//! transforms are allocation-free. At least three present reference markers are needed; with
+//! fewer the last pose is held and the frame is flagged.
+
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Why stabilisation could not be set up.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StabiliseError {
+    /// Fewer than three reference markers were given or found.
+    #[error("head stabilisation needs at least 3 reference markers, got {0}")]
+    TooFewReferences(usize),
+    /// A reference marker index is out of range.
+    #[error("reference marker {index} out of range for {markers} markers")]
+    BadIndex {
+        /// The index given.
+        index: usize,
+        /// Markers in a frame.
+        markers: usize,
+    },
+    /// No training frame shows at least three reference markers.
+    #[error("no frame shows at least 3 of the reference markers")]
+    NoUsableFrame,
+    /// The reference markers are (nearly) collinear, so rotation is undetermined.
+    #[error("reference markers are collinear: rotation about their line is undetermined")]
+    Degenerate,
+}
+
+/// The stored stabilisation: which markers are rigid and their shape in head coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HeadReference {
+    /// Marker indices (into the model's labels) of the rigid reference markers.
+    pub markers: Vec<usize>,
+    /// The reference shape in head coordinates (mm), one point per reference marker, centred.
+    pub template: Vec<[f64; 3]>,
+}
+
+/// A frame's rigid head pose: `world = rotation · head + translation`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// Rotation from head to world coordinates.
+    pub rotation: Matrix3<f64>,
+    /// Translation from head to world coordinates (mm).
+    pub translation: Vector3<f64>,
+}
+
+impl Pose {
+    /// The identity pose.
+    pub fn identity() -> Pose {
+        Pose {
+            rotation: Matrix3::identity(),
+            translation: Vector3::zeros(),
+        }
+    }
+}
+
+/// What [`Stabiliser::estimate`] found for one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoseEstimate {
+    /// The pose used for the frame.
+    pub pose: Pose,
+    /// RMS distance (mm) between the posed template and the observed reference markers.
+    pub residual_mm: f64,
+    /// Reference markers present in the frame.
+    pub used: usize,
+    /// True when fewer than three reference markers were present and the last pose was held.
+    pub held: bool,
+}
+
+/// Kabsch fit of `template` points onto `observed` points (pairs where `present`), minimising the
+/// squared distances. Returns `None` with fewer than three pairs or a degenerate configuration.
+fn kabsch<'a>(
+    pairs: impl Iterator<Item = (&'a [f64; 3], Vector3<f64>)> + Clone,
+) -> Option<(Pose, usize)> {
+    let mut count = 0usize;
+    let mut p_mean = Vector3::zeros();
+    let mut q_mean = Vector3::zeros();
+    for (p, q) in pairs.clone() {
+        p_mean += Vector3::from(*p);
+        q_mean += q;
+        count += 1;
+    }
+    if count < 3 {
+        return None;
+    }
+    p_mean /= count as f64;
+    q_mean /= count as f64;
+    let mut h = Matrix3::zeros();
+    for (p, q) in pairs {
+        h += (Vector3::from(*p) - p_mean) * (q - q_mean).transpose();
+    }
+    let svd = h.svd(true, true);
+    let (u, v_t) = (svd.u?, svd.v_t?);
+    // Two vanishing singular values mean the points are collinear (or coincide).
+    let s = svd.singular_values;
+    if s[1] <= 1e-9 * s[0].max(1e-300) {
+        return None;
+    }
+    let v = v_t.transpose();
+    let d = (v * u.transpose()).determinant().signum();
+    let rotation = v * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d)) * u.transpose();
+    let translation = q_mean - rotation * p_mean;
+    Some((
+        Pose {
+            rotation,
+            translation,
+        },
+        count,
+    ))
+}
+
+fn point(frame: &[f32], marker: usize) -> Vector3<f64> {
+    let i = marker * 3;
+    Vector3::new(frame[i] as f64, frame[i + 1] as f64, frame[i + 2] as f64)
+}
+
+/// Per-frame stabiliser built from a [`HeadReference`].
+#[derive(Debug, Clone)]
+pub struct Stabiliser {
+    reference: HeadReference,
+    last: Pose,
+}
+
+impl Stabiliser {
+    /// A stabiliser for a stored reference.
+    ///
+    /// # Errors
+    /// [`StabiliseError::TooFewReferences`] when the reference has fewer than three markers.
+    pub fn new(reference: HeadReference) -> Result<Stabiliser, StabiliseError> {
+        if reference.markers.len() < 3 || reference.template.len() != reference.markers.len() {
+            return Err(StabiliseError::TooFewReferences(reference.markers.len()));
+        }
+        Ok(Stabiliser {
+            reference,
+            last: Pose::identity(),
+        })
+    }
+
+    /// Builds the template from training frames by generalised Procrustes averaging.
+    ///
+    /// `frames` is frames x markers x 3 (mm), `missing` frames x markers.
+    ///
+    /// # Errors
+    /// Too few or out-of-range reference markers, no usable frame, collinear references.
+    pub fn fit(
+        frames: &[f32],
+        missing: &[bool],
+        n_markers: usize,
+        markers: Vec<usize>,
+    ) -> Result<Stabiliser, StabiliseError> {
+        if markers.len() < 3 {
+            return Err(StabiliseError::TooFewReferences(markers.len()));
+        }
+        if let Some(&index) = markers.iter().find(|&&i| i >= n_markers) {
+            return Err(StabiliseError::BadIndex {
+                index,
+                markers: n_markers,
+            });
+        }
+        let n_frames = missing.len() / n_markers.max(1);
+        let complete = |f: usize| markers.iter().all(|&m| !missing[f * n_markers + m]);
+        let first = (0..n_frames)
+            .find(|&f| complete(f))
+            .ok_or(StabiliseError::NoUsableFrame)?;
+        let frame_of = |f: usize| &frames[f * n_markers * 3..(f + 1) * n_markers * 3];
+        let mut template: Vec<[f64; 3]> = markers
+            .iter()
+            .map(|&m| point(frame_of(first), m).into())
+            .collect();
+        centre(&mut template);
+        for _ in 0..3 {
+            let mut sum = vec![Vector3::<f64>::zeros(); markers.len()];
+            let mut count = vec![0usize; markers.len()];
+            for f in 0..n_frames {
+                let frame = frame_of(f);
+                let present = |k: &usize| !missing[f * n_markers + markers[*k]];
+                let pairs = (0..markers.len())
+                    .filter(present)
+                    .map(|k| (&template[k], point(frame, markers[k])));
+                let Some((pose, _)) = kabsch(pairs) else {
+                    continue;
+                };
+                let inv = pose.rotation.transpose();
+                for k in (0..markers.len()).filter(present) {
+                    sum[k] += inv * (point(frame, markers[k]) - pose.translation);
+                    count[k] += 1;
+                }
+            }
+            for k in 0..markers.len() {
+                if count[k] > 0 {
+                    template[k] = (sum[k] / count[k] as f64).into();
+                }
+            }
+            centre(&mut template);
+        }
+        let reference = HeadReference { markers, template };
+        // A template whose own points are collinear cannot fix a rotation.
+        let own = reference.template.iter().map(|p| (p, Vector3::from(*p)));
+        kabsch(own).ok_or(StabiliseError::Degenerate)?;
+        Stabiliser::new(reference)
+    }
+
+    /// The stored reference (for the model file).
+    pub fn reference(&self) -> &HeadReference {
+        &self.reference
+    }
+
+    /// Estimates the head pose of one frame (markers x 3, mm). Allocation-free.
+    ///
+    /// With fewer than three present reference markers the previous pose is held.
+    pub fn estimate(&mut self, frame: &[f32], missing: &[bool]) -> PoseEstimate {
+        let r = &self.reference;
+        let pairs = r
+            .markers
+            .iter()
+            .zip(&r.template)
+            .filter(|(&m, _)| !missing[m])
+            .map(|(&m, p)| (p, point(frame, m)));
+        match kabsch(pairs.clone()) {
+            Some((pose, used)) => {
+                let sq: f64 = pairs
+                    .map(|(p, q)| {
+                        (pose.rotation * Vector3::from(*p) + pose.translation - q).norm_squared()
+                    })
+                    .sum();
+                self.last = pose;
+                PoseEstimate {
+                    pose,
+                    residual_mm: (sq / used as f64).sqrt(),
+                    used,
+                    held: false,
+                }
+            }
+            None => PoseEstimate {
+                pose: self.last,
+                residual_mm: f64::NAN,
+                used: r.markers.iter().filter(|&&m| !missing[m]).count(),
+                held: true,
+            },
+        }
+    }
+
+    /// Forgets the held pose (e.g. at the start of a new take).
+    pub fn reset(&mut self) {
+        self.last = Pose::identity();
+    }
+}
+
+fn centre(points: &mut [[f64; 3]]) {
+    let n = points.len().max(1) as f64;
+    let mut mean = [0.0; 3];
+    for p in points.iter() {
+        for a in 0..3 {
+            mean[a] += p[a] / n;
+        }
+    }
+    for p in points.iter_mut() {
+        for a in 0..3 {
+            p[a] -= mean[a];
+        }
+    }
+}
+
+/// Maps a frame from world to head coordinates: `head = Rᵀ (world − t)`. Missing samples are
+/// copied unchanged.
+pub fn to_head_into(pose: &Pose, world: &[f32], missing: &[bool], head: &mut [f32]) {
+    let inv = pose.rotation.transpose();
+    for (m, &gone) in missing.iter().enumerate() {
+        let i = m * 3;
+        if gone {
+            head[i..i + 3].copy_from_slice(&world[i..i + 3]);
+            continue;
+        }
+        let h = inv * (point(world, m) - pose.translation);
+        head[i] = h.x as f32;
+        head[i + 1] = h.y as f32;
+        head[i + 2] = h.z as f32;
+    }
+}
+
+/// Maps a frame from head to world coordinates: `world = R · head + t`.
+pub fn to_world_into(pose: &Pose, head: &[f32], world: &mut [f32]) {
+    for m in 0..head.len() / 3 {
+        let i = m * 3;
+        let w = pose.rotation * point(head, m) + pose.translation;
+        world[i] = w.x as f32;
+        world[i + 1] = w.y as f32;
+        world[i + 2] = w.z as f32;
+    }
+}
+
+/// Chooses `count` rigid reference markers automatically: the set whose pairwise distances vary
+/// least over the frames (greedy: the most stable pair, then repeatedly the marker whose mean
+/// distance standard deviation to the chosen set is smallest). Markers missing in more than half
+/// of the frames are never chosen. Every `stride`-th frame is used, to bound the cost.
+pub fn choose_reference(
+    frames: &[f32],
+    missing: &[bool],
+    n_markers: usize,
+    count: usize,
+    stride: usize,
+) -> Vec<usize> {
+    let n_frames = missing.len() / n_markers.max(1);
+    let stride = stride.max(1);
+    let present = |f: usize, m: usize| !missing[f * n_markers + m];
+    let usable: Vec<usize> = (0..n_markers)
+        .filter(|&m| (0..n_frames).filter(|&f| present(f, m)).count() * 2 > n_frames)
+        .collect();
+    let mut spread = vec![f64::INFINITY; n_markers * n_markers];
+    for (ai, &a) in usable.iter().enumerate() {
+        for &b in &usable[ai + 1..] {
+            let (mut n, mut s, mut s2) = (0.0, 0.0, 0.0);
+            for f in (0..n_frames).step_by(stride) {
+                if present(f, a) && present(f, b) {
+                    let fr = &frames[f * n_markers * 3..(f + 1) * n_markers * 3];
+                    let d = (point(fr, a) - point(fr, b)).norm();
+                    n += 1.0;
+                    s += d;
+                    s2 += d * d;
+                }
+            }
+            if n >= 2.0 {
+                let var = (s2 - s * s / n) / (n - 1.0);
+                spread[a * n_markers + b] = var.max(0.0).sqrt();
+                spread[b * n_markers + a] = spread[a * n_markers + b];
+            }
+        }
+    }
+    let mut best_pair = None;
+    let mut best = f64::INFINITY;
+    for (ai, &a) in usable.iter().enumerate() {
+        for &b in &usable[ai + 1..] {
+            if spread[a * n_markers + b] < best {
+                best = spread[a * n_markers + b];
+                best_pair = Some((a, b));
+            }
+        }
+    }
+    let Some((a, b)) = best_pair else {
+        return Vec::new();
+    };
+    let mut chosen = vec![a, b];
+    while chosen.len() < count.min(usable.len()) {
+        let next = usable
+            .iter()
+            .filter(|m| !chosen.contains(m))
+            .map(|&m| {
+                let mean = chosen
+                    .iter()
+                    .map(|&c| spread[m * n_markers + c])
+                    .sum::<f64>()
+                    / chosen.len() as f64;
+                (m, mean)
+            })
+            .min_by(|x, y| x.1.total_cmp(&y.1));
+        match next {
+            Some((m, s)) if s.is_finite() => chosen.push(m),
+            _ => break,
+        }
+    }
+    chosen.sort_unstable();
+    chosen
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Rotation3;
+
+    /// 6 markers: 4 rigid (a tetrahedron) and 2 that move on their own.
+    fn scene(frames: usize) -> (Vec<f32>, Vec<Pose>) {
+        let rigid = [
+            [0.0, 80.0, 20.0],
+            [40.0, 60.0, 10.0],
+            [-40.0, 60.0, 10.0],
+            [0.0, 30.0, 60.0],
+        ];
+        let mut out = Vec::new();
+        let mut poses = Vec::new();
+        for f in 0..frames {
+            let t = f as f64 * 0.05;
+            let rot =
+                Rotation3::from_euler_angles(0.1 * t.sin(), 0.2 * (0.7 * t).sin(), 0.05 * t.cos());
+            let pose = Pose {
+                rotation: *rot.matrix(),
+                translation: Vector3::new(5.0 * t.sin(), 3.0 * t.cos(), 100.0),
+            };
+            let free = [
+                [20.0 + 8.0 * (3.0 * t).sin(), -30.0, 40.0],
+                [-20.0, -30.0 - 6.0 * t.cos(), 40.0],
+            ];
+            for p in rigid.iter().chain(free.iter()) {
+                let w = pose.rotation * Vector3::from(*p) + pose.translation;
+                out.extend([w.x as f32, w.y as f32, w.z as f32]);
+            }
+            poses.push(pose);
+        }
+        (out, poses)
+    }
+
+    #[test]
+    fn automatic_choice_finds_the_rigid_markers() {
+        let (frames, _) = scene(200);
+        let missing = vec![false; 200 * 6];
+        assert_eq!(
+            choose_reference(&frames, &missing, 6, 4, 1),
+            vec![0, 1, 2, 3]
+        );
+    }
+
+    #[test]
+    fn round_trip_removes_and_restores_head_motion() {
+        let (frames, _) = scene(100);
+        let mut missing = vec![false; 100 * 6];
+        missing[10 * 6 + 2] = true; // a reference marker drops out in frame 10
+        let mut st = Stabiliser::fit(&frames, &missing, 6, vec![0, 1, 2, 3]).expect("fit");
+        let mut head = vec![0.0f32; 18];
+        let mut back = vec![0.0f32; 18];
+        let mut first_head: Option<Vec<f32>> = None;
+        for f in 0..100 {
+            let fr = &frames[f * 18..(f + 1) * 18];
+            let miss = &missing[f * 6..(f + 1) * 6];
+            let est = st.estimate(fr, miss);
+            assert!(!est.held);
+            assert!(est.residual_mm < 1e-3, "residual {}", est.residual_mm);
+            to_head_into(&est.pose, fr, miss, &mut head);
+            to_world_into(&est.pose, &head, &mut back);
+            for m in (0..6).filter(|&m| !miss[m]) {
+                for a in 0..3 {
+                    assert!((back[m * 3 + a] - fr[m * 3 + a]).abs() < 1e-3);
+                }
+            }
+            // Rigid markers stay put in head coordinates.
+            let first = first_head.get_or_insert_with(|| head.clone());
+            for m in [0, 1, 3] {
+                for a in 0..3 {
+                    assert!((head[m * 3 + a] - first[m * 3 + a]).abs() < 1e-3);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn too_few_references_hold_the_last_pose() {
+        let (frames, _) = scene(3);
+        let missing = vec![false; 18];
+        let mut st = Stabiliser::fit(&frames, &missing, 6, vec![0, 1, 2, 3]).expect("fit");
+        let good = st.estimate(&frames[..18], &missing[..6]);
+        let gone = [true, true, false, false, false, false];
+        let held = st.estimate(&frames[18..36], &gone);
+        assert!(held.held);
+        assert_eq!(held.pose, good.pose);
+    }
+
+    #[test]
+    fn bad_setups_are_errors() {
+        let (frames, _) = scene(3);
+        let missing = vec![false; 18];
+        assert_eq!(
+            Stabiliser::fit(&frames, &missing, 6, vec![0, 1]).unwrap_err(),
+            StabiliseError::TooFewReferences(2)
+        );
+        assert!(matches!(
+            Stabiliser::fit(&frames, &missing, 6, vec![0, 1, 9]),
+            Err(StabiliseError::BadIndex { index: 9, .. })
+        ));
+        // Three collinear points.
+        let line: Vec<f32> = (0..3).flat_map(|k| [k as f32 * 10.0, 0.0, 0.0]).collect();
+        assert_eq!(
+            Stabiliser::fit(&line, &[false; 3], 3, vec![0, 1, 2]).unwrap_err(),
+            StabiliseError::Degenerate
+        );
+    }
+}
