@@ -1,1 +1,348 @@
-//! (being written)
+//! Edits in component space (paper section 5), per frame and on whole takes.
+//!
+//! - *Translate*: `u + α e_k`, an offset on one component ([`FrameEdit::set_offset`],
+//!   [`translate`]).
+//! - Gain: `u_k ← g_k u_k` ([`FrameEdit::set_gain`], [`scale_component`]).
+//! - *Copy and Replace*: component `k` of take 1 replaced by that of take 2
+//!   ([`set_component_from`], or per frame [`FrameEdit::set_override`]).
+//! - *Copy and Add* across two models: `x = mean₁ + M₁u₁ + M₂ (u₂ᵀe_k) e_k`
+//!   ([`copy_add_into`] per frame).
+//!
+//! Whole takes are component series, frames x components (`DMatrix<f64>`, as
+//! [`crate::model::IcaModel::project`] returns them). Takes of different lengths must be
+//! aligned (resampled or time-warped) by the caller before a replace.
+
+use crate::project::{FrameError, Projector};
+use nalgebra::DMatrix;
+
+/// Why an edit could not be set up. Small and `Copy`, like [`FrameError`].
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum EditError {
+    /// A component index is outside the model.
+    #[error("component {index} is out of range: the edit has {components} components")]
+    ComponentOutOfRange {
+        /// The index.
+        index: usize,
+        /// Components.
+        components: usize,
+    },
+    /// An offset, gain or value is NaN or infinite.
+    #[error("{what} for component {index} is not finite: {value}")]
+    NonFinite {
+        /// `offset`, `gain`, `override` or `value`.
+        what: &'static str,
+        /// Component.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A value series does not have one value per frame.
+    #[error("value series has {got} values for a take of {expected} frames")]
+    SeriesLength {
+        /// Frames in the take.
+        expected: usize,
+        /// Values given.
+        got: usize,
+    },
+}
+
+/// A per-frame edit: `u'_k = override_k` if set, else `g_k u_k + offset_k`. Sized once for a
+/// model's components; [`FrameEdit::apply`] does not allocate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameEdit {
+    offsets: Vec<f32>,
+    gains: Vec<f32>,
+    overrides: Vec<Option<f32>>,
+}
+
+impl FrameEdit {
+    /// The identity edit for `components` components.
+    pub fn identity(components: usize) -> FrameEdit {
+        FrameEdit {
+            offsets: vec![0.0; components],
+            gains: vec![1.0; components],
+            overrides: vec![None; components],
+        }
+    }
+
+    /// Components this edit is sized for.
+    pub fn components(&self) -> usize {
+        self.offsets.len()
+    }
+
+    /// Whether the edit changes nothing.
+    pub fn is_identity(&self) -> bool {
+        self.offsets.iter().all(|&o| o == 0.0)
+            && self.gains.iter().all(|&g| g == 1.0)
+            && self.overrides.iter().all(Option::is_none)
+    }
+
+    /// Back to the identity, keeping the buffers.
+    pub fn reset(&mut self) {
+        self.offsets.fill(0.0);
+        self.gains.fill(1.0);
+        self.overrides.fill(None);
+    }
+
+    /// *Translate*: add `alpha` to component `k` (replaces a previous offset).
+    ///
+    /// # Errors
+    /// [`EditError`] for a bad index or a non-finite value.
+    pub fn set_offset(&mut self, k: usize, alpha: f32) -> Result<(), EditError> {
+        self.check(k, "offset", alpha)?;
+        self.offsets[k] = alpha;
+        Ok(())
+    }
+
+    /// Multiply component `k` by `gain` (before the offset).
+    ///
+    /// # Errors
+    /// [`EditError`] for a bad index or a non-finite value.
+    pub fn set_gain(&mut self, k: usize, gain: f32) -> Result<(), EditError> {
+        self.check(k, "gain", gain)?;
+        self.gains[k] = gain;
+        Ok(())
+    }
+
+    /// Force component `k` to `value` (per-frame *Copy and Replace*), or clear the override.
+    ///
+    /// # Errors
+    /// [`EditError`] for a bad index or a non-finite value.
+    pub fn set_override(&mut self, k: usize, value: Option<f32>) -> Result<(), EditError> {
+        self.check(k, "override", value.unwrap_or(0.0))?;
+        self.overrides[k] = value;
+        Ok(())
+    }
+
+    /// Offset of component `k` (0 when out of range).
+    pub fn offset(&self, k: usize) -> f32 {
+        self.offsets.get(k).copied().unwrap_or(0.0)
+    }
+
+    /// Gain of component `k` (1 when out of range).
+    pub fn gain(&self, k: usize) -> f32 {
+        self.gains.get(k).copied().unwrap_or(1.0)
+    }
+
+    /// Applies the edit to one frame's components in place.
+    ///
+    /// # Errors
+    /// [`FrameError::Length`] when `u` does not have [`FrameEdit::components`] values.
+    pub fn apply(&self, u: &mut [f32]) -> Result<(), FrameError> {
+        if u.len() != self.offsets.len() {
+            return Err(FrameError::Length {
+                what: "components",
+                expected: self.offsets.len(),
+                got: u.len(),
+            });
+        }
+        for ((ui, g), o) in u.iter_mut().zip(&self.gains).zip(&self.offsets) {
+            *ui = *ui * g + o;
+        }
+        for (ui, ov) in u.iter_mut().zip(&self.overrides) {
+            if let Some(v) = ov {
+                *ui = *v;
+            }
+        }
+        Ok(())
+    }
+
+    fn check(&self, k: usize, what: &'static str, value: f32) -> Result<(), EditError> {
+        if k >= self.offsets.len() {
+            return Err(EditError::ComponentOutOfRange {
+                index: k,
+                components: self.offsets.len(),
+            });
+        }
+        if !value.is_finite() {
+            return Err(EditError::NonFinite {
+                what,
+                index: k,
+                value: f64::from(value),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// *Copy and Add* for one frame: `out = mean₁ + M₁u₁ + M₂[:, k] · u₂[k]`, adding component
+/// `k` of a second model's frame to the first model's resynthesis. Both models must have the
+/// same channels (the same markers in the same order).
+///
+/// # Errors
+/// [`FrameError`] when a buffer does not match its model or `k` is out of range.
+pub fn copy_add_into(
+    target: &Projector,
+    u1: &[f32],
+    source: &Projector,
+    u2: &[f32],
+    k: usize,
+    out: &mut [f32],
+) -> Result<(), FrameError> {
+    if source.channels() != target.channels() {
+        return Err(FrameError::Length {
+            what: "source model channels",
+            expected: target.channels(),
+            got: source.channels(),
+        });
+    }
+    let value = *u2.get(k).ok_or(FrameError::ComponentOutOfRange {
+        index: k,
+        components: u2.len(),
+    })?;
+    target.resynth_into(u1, out)?;
+    source.add_component_into(k, value, out)
+}
+
+/// *Translate* a whole take: `u_k += alpha` in every frame.
+///
+/// # Errors
+/// [`EditError`] for a bad index or a non-finite `alpha`.
+pub fn translate(series: &mut DMatrix<f64>, k: usize, alpha: f64) -> Result<(), EditError> {
+    check_series(series, k, "offset", alpha)?;
+    series.column_mut(k).add_scalar_mut(alpha);
+    Ok(())
+}
+
+/// Scale component `k` of a whole take by `gain`.
+///
+/// # Errors
+/// [`EditError`] for a bad index or a non-finite `gain`.
+pub fn scale_component(series: &mut DMatrix<f64>, k: usize, gain: f64) -> Result<(), EditError> {
+    check_series(series, k, "gain", gain)?;
+    series.column_mut(k).scale_mut(gain);
+    Ok(())
+}
+
+/// Replace component `k` of a whole take with `values`, one per frame: the basis of *Copy
+/// and Replace* (`values` being component `k` of another take, aligned to this one).
+///
+/// # Errors
+/// [`EditError::SeriesLength`] when `values` has not one value per frame; bad index or a
+/// non-finite value as for the other edits.
+pub fn set_component_from(
+    series: &mut DMatrix<f64>,
+    k: usize,
+    values: &[f64],
+) -> Result<(), EditError> {
+    check_series(series, k, "value", 0.0)?;
+    if values.len() != series.nrows() {
+        return Err(EditError::SeriesLength {
+            expected: series.nrows(),
+            got: values.len(),
+        });
+    }
+    if let Some(&value) = values.iter().find(|v| !v.is_finite()) {
+        return Err(EditError::NonFinite {
+            what: "value",
+            index: k,
+            value,
+        });
+    }
+    series.column_mut(k).copy_from_slice(values);
+    Ok(())
+}
+
+/// *Copy and Replace* between two aligned takes of the same model: component `k` of
+/// `target` becomes component `k` of `source`.
+///
+/// # Errors
+/// As [`set_component_from`].
+pub fn copy_replace(
+    target: &mut DMatrix<f64>,
+    source: &DMatrix<f64>,
+    k: usize,
+) -> Result<(), EditError> {
+    if k >= source.ncols() {
+        return Err(EditError::ComponentOutOfRange {
+            index: k,
+            components: source.ncols(),
+        });
+    }
+    let values: Vec<f64> = source.column(k).iter().copied().collect();
+    set_component_from(target, k, &values)
+}
+
+fn check_series(
+    series: &DMatrix<f64>,
+    k: usize,
+    what: &'static str,
+    value: f64,
+) -> Result<(), EditError> {
+    if k >= series.ncols() {
+        return Err(EditError::ComponentOutOfRange {
+            index: k,
+            components: series.ncols(),
+        });
+    }
+    if !value.is_finite() {
+        return Err(EditError::NonFinite {
+            what,
+            index: k,
+            value,
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_edit_order_is_gain_offset_then_override() {
+        let mut e = FrameEdit::identity(3);
+        assert!(e.is_identity());
+        e.set_gain(0, 2.0).expect("in range");
+        e.set_offset(0, 0.5).expect("in range");
+        e.set_offset(1, -1.0).expect("in range");
+        e.set_override(2, Some(7.0)).expect("in range");
+        let mut u = [1.0, 1.0, 1.0];
+        e.apply(&mut u).expect("sized for 3");
+        assert_eq!(u, [2.5, 0.0, 7.0]);
+        assert!(matches!(
+            e.set_gain(3, 1.0),
+            Err(EditError::ComponentOutOfRange {
+                index: 3,
+                components: 3
+            })
+        ));
+        assert!(matches!(
+            e.set_offset(1, f32::NAN),
+            Err(EditError::NonFinite { what: "offset", .. })
+        ));
+        assert!(matches!(
+            e.apply(&mut [0.0; 2]),
+            Err(FrameError::Length {
+                expected: 3,
+                got: 2,
+                ..
+            })
+        ));
+        e.reset();
+        assert!(e.is_identity());
+    }
+
+    #[test]
+    fn whole_take_edits() {
+        let mut s = DMatrix::from_row_slice(3, 2, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        translate(&mut s, 1, 10.0).expect("in range");
+        assert_eq!(s.column(1).as_slice(), &[12.0, 14.0, 16.0]);
+        scale_component(&mut s, 0, -1.0).expect("in range");
+        assert_eq!(s.column(0).as_slice(), &[-1.0, -3.0, -5.0]);
+        set_component_from(&mut s, 0, &[9.0, 8.0, 7.0]).expect("one per frame");
+        assert_eq!(s.column(0).as_slice(), &[9.0, 8.0, 7.0]);
+        assert!(matches!(
+            set_component_from(&mut s, 0, &[1.0]),
+            Err(EditError::SeriesLength {
+                expected: 3,
+                got: 1
+            })
+        ));
+        let other = DMatrix::from_row_slice(3, 2, &[0.0, -1.0, 0.0, -2.0, 0.0, -3.0]);
+        copy_replace(&mut s, &other, 1).expect("aligned");
+        assert_eq!(s.column(1).as_slice(), &[-1.0, -2.0, -3.0]);
+        assert_eq!(s.column(0).as_slice(), &[9.0, 8.0, 7.0]);
+        assert!(translate(&mut s, 2, 1.0).is_err());
+    }
+}

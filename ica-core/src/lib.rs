@@ -12,3 +12,7 @@ pub mod whiten;
 
 pub use report::{RestartReport, TrainReport};
 pub use fit::{amari_index, FastIcaParams, FitData, FitError, FitOutput};
+
+pub use edit::{EditError, FrameEdit};
+pub use model::{EmotionLevels, IcaModel, ModelError, Role, FORMAT_VERSION};
+pub use project::{FrameError, FrameStatus, Projector};

@@ -1,0 +1,417 @@
+//! The fitted ICA model of a face, `x ≈ mean + M·u` (paper eq. 2, `M = P·A`), and its file.
+//!
+//! [`IcaModel`] holds the mean, the mixing matrix `M` (channels x components), the unmixing
+//! matrix `W = M⁺` (components x channels), the marker labels, the frame rate, a [`Role`] per
+//! component, the named emotion levels and the [`TrainReport`]. Every constructor and the
+//! loader validate, so an `IcaModel` value is always consistent: shapes agree, entries are
+//! finite, `M` has full column rank and `W` is its pseudo-inverse.
+//!
+//! Whole takes are projected and resynthesised in f64 here ([`IcaModel::project`],
+//! [`IcaModel::resynthesize`]); the per-frame f32 path is [`crate::project::Projector`].
+
+mod error;
+mod file;
+mod json_rows;
+
+pub use error::ModelError;
+pub use file::FORMAT_VERSION;
+
+use crate::report::TrainReport;
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, HashMap};
+
+/// A mixing matrix whose smallest singular value is at most `RANK_TOL` x its largest is
+/// rejected as rank deficient: beyond a condition number of 1e8 the projection amplifies f64
+/// rounding to ~1e-8 of the signal and f32 rounding to more than the signal.
+pub const RANK_TOL: f64 = 1e-8;
+
+/// Largest deviation allowed in the Penrose checks of a stored unmixing matrix (`W·M = I`,
+/// `M·W` symmetric). Both products are dimensionless; a model within [`RANK_TOL`] round-trips
+/// through JSON at ~1e-8, so 1e-6 only trips on a matrix that was edited or corrupted.
+pub const PINV_TOL: f64 = 1e-6;
+
+/// What an independent component was found to carry (paper section 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// Not analysed yet.
+    #[default]
+    Unknown,
+    /// The emotion component.
+    Emotion,
+    /// Speech (mouth and jaw) motion.
+    Speech,
+    /// Non-emotional eyebrow motion.
+    Eyebrows,
+    /// Blinking.
+    Eyelids,
+    /// Analysed, none of the above.
+    Other,
+}
+
+/// Named values of the emotion component, e.g. `happy → 1.8`, `frustrated → -1.2`: the
+/// extremes the paper's *Translate* edit moves between.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct EmotionLevels {
+    /// Which component carries emotion, once known.
+    pub component: Option<usize>,
+    /// Level name → value of the emotion component, ordered by name.
+    pub levels: BTreeMap<String, f64>,
+}
+
+/// A validated ICA model. See the module docs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IcaModel {
+    labels: Vec<String>,
+    rate_hz: f64,
+    mean: Vec<f64>,
+    mixing: DMatrix<f64>,
+    unmixing: DMatrix<f64>,
+    roles: Vec<Role>,
+    emotion: EmotionLevels,
+    report: TrainReport,
+}
+
+impl IcaModel {
+    /// Builds a model from a fit: `x ≈ mean + mixing·u`, computing `W = mixing⁺` by SVD.
+    /// Roles start [`Role::Unknown`]; there are no emotion levels yet.
+    ///
+    /// # Errors
+    /// [`ModelError`] when shapes disagree (labels x 3 ≠ channels, mean length, report
+    /// channels/components), a value is non-finite, a label is empty or repeated, the rate
+    /// is not positive, or `mixing` is rank deficient (see [`RANK_TOL`]).
+    pub fn new(
+        labels: Vec<String>,
+        rate_hz: f64,
+        mean: Vec<f64>,
+        mixing: DMatrix<f64>,
+        report: TrainReport,
+    ) -> Result<IcaModel, ModelError> {
+        check_parts(&labels, rate_hz, &mean, &mixing, &report)?;
+        let unmixing = pseudo_inverse(&mixing)?;
+        let roles = vec![Role::Unknown; mixing.ncols()];
+        Ok(IcaModel {
+            labels,
+            rate_hz,
+            mean,
+            mixing,
+            unmixing,
+            roles,
+            emotion: EmotionLevels::default(),
+            report,
+        })
+    }
+
+    /// Marker labels, one per marker (channels `3i..3i+3` are marker `i`'s x, y, z).
+    pub fn labels(&self) -> &[String] {
+        &self.labels
+    }
+
+    /// Frame rate of the training data.
+    pub fn rate_hz(&self) -> f64 {
+        self.rate_hz
+    }
+
+    /// The mean pose, one value per channel.
+    pub fn mean(&self) -> &[f64] {
+        &self.mean
+    }
+
+    /// Mixing matrix `M = P·A`, channels x components.
+    pub fn mixing(&self) -> &DMatrix<f64> {
+        &self.mixing
+    }
+
+    /// Unmixing matrix `W = M⁺`, components x channels.
+    pub fn unmixing(&self) -> &DMatrix<f64> {
+        &self.unmixing
+    }
+
+    /// Channels (markers x 3).
+    pub fn channels(&self) -> usize {
+        self.mixing.nrows()
+    }
+
+    /// Markers.
+    pub fn markers(&self) -> usize {
+        self.labels.len()
+    }
+
+    /// Independent components kept.
+    pub fn components(&self) -> usize {
+        self.mixing.ncols()
+    }
+
+    /// Share of the total variance the kept principal components explain (from the report).
+    pub fn variance_kept(&self) -> f64 {
+        self.report.variance_kept
+    }
+
+    /// The role of each component.
+    pub fn roles(&self) -> &[Role] {
+        &self.roles
+    }
+
+    /// The emotion component and its named levels.
+    pub fn emotion(&self) -> &EmotionLevels {
+        &self.emotion
+    }
+
+    /// What training did.
+    pub fn report(&self) -> &TrainReport {
+        &self.report
+    }
+
+    /// Index of the marker with this label.
+    pub fn marker_index(&self, label: &str) -> Option<usize> {
+        self.labels.iter().position(|l| l == label)
+    }
+
+    /// Sets the role of component `k`.
+    ///
+    /// # Errors
+    /// [`ModelError::ComponentOutOfRange`] when `k >= components`.
+    pub fn set_role(&mut self, k: usize, role: Role) -> Result<(), ModelError> {
+        self.check_component("role component", k)?;
+        self.roles[k] = role;
+        Ok(())
+    }
+
+    /// Marks component `k` (or none) as the emotion component. Also sets its role to
+    /// [`Role::Emotion`] and resets a previous emotion component's role to [`Role::Unknown`].
+    ///
+    /// # Errors
+    /// [`ModelError::ComponentOutOfRange`] when `k >= components`.
+    pub fn set_emotion_component(&mut self, k: Option<usize>) -> Result<(), ModelError> {
+        if let Some(k) = k {
+            self.check_component("emotion component", k)?;
+        }
+        if let Some(old) = self.emotion.component {
+            if self.roles[old] == Role::Emotion {
+                self.roles[old] = Role::Unknown;
+            }
+        }
+        if let Some(k) = k {
+            self.roles[k] = Role::Emotion;
+        }
+        self.emotion.component = k;
+        Ok(())
+    }
+
+    /// Names a value of the emotion component (replacing a level of the same name).
+    ///
+    /// # Errors
+    /// [`ModelError::NonFiniteLevel`] when `value` is NaN or infinite.
+    pub fn set_emotion_level(&mut self, name: &str, value: f64) -> Result<(), ModelError> {
+        if !value.is_finite() {
+            return Err(ModelError::NonFiniteLevel {
+                name: name.to_string(),
+            });
+        }
+        self.emotion.levels.insert(name.to_string(), value);
+        Ok(())
+    }
+
+    /// Removes a named emotion level, returning its value.
+    pub fn remove_emotion_level(&mut self, name: &str) -> Option<f64> {
+        self.emotion.levels.remove(name)
+    }
+
+    /// Projects a take, frames x channels, to its components, frames x components:
+    /// `u = W (x - mean)` per frame, in f64.
+    ///
+    /// # Errors
+    /// [`ModelError::ShapeMismatch`] when `frames` does not have `channels` columns.
+    pub fn project(&self, frames: &DMatrix<f64>) -> Result<DMatrix<f64>, ModelError> {
+        let n = self.channels();
+        if frames.ncols() != n {
+            return Err(ModelError::ShapeMismatch {
+                what: "take",
+                expected: (frames.nrows(), n),
+                got: frames.shape(),
+            });
+        }
+        let mut centered = frames.clone();
+        for (j, mut col) in centered.column_iter_mut().enumerate() {
+            col.add_scalar_mut(-self.mean[j]);
+        }
+        Ok(centered * self.unmixing.transpose())
+    }
+
+    /// Resynthesises a take from components, frames x components, to frames x channels:
+    /// `x = mean + M u` per frame, in f64.
+    ///
+    /// # Errors
+    /// [`ModelError::ShapeMismatch`] when `components` does not have `components` columns.
+    pub fn resynthesize(&self, components: &DMatrix<f64>) -> Result<DMatrix<f64>, ModelError> {
+        let m = self.components();
+        if components.ncols() != m {
+            return Err(ModelError::ShapeMismatch {
+                what: "component series",
+                expected: (components.nrows(), m),
+                got: components.shape(),
+            });
+        }
+        let mut out = components * self.mixing.transpose();
+        for (j, mut col) in out.column_iter_mut().enumerate() {
+            col.add_scalar_mut(self.mean[j]);
+        }
+        Ok(out)
+    }
+
+    fn check_component(&self, what: &'static str, k: usize) -> Result<(), ModelError> {
+        let components = self.components();
+        if k < components {
+            Ok(())
+        } else {
+            Err(ModelError::ComponentOutOfRange {
+                what,
+                index: k,
+                components,
+            })
+        }
+    }
+}
+
+/// Validates everything about a model's parts except the unmixing matrix.
+fn check_parts(
+    labels: &[String],
+    rate_hz: f64,
+    mean: &[f64],
+    mixing: &DMatrix<f64>,
+    report: &TrainReport,
+) -> Result<(), ModelError> {
+    let (n, m) = mixing.shape();
+    if n % 3 != 0 {
+        return Err(ModelError::ChannelsNotTriples { channels: n });
+    }
+    if m == 0 || m > n {
+        return Err(ModelError::ComponentCount {
+            components: m,
+            channels: n,
+        });
+    }
+    if labels.len() * 3 != n {
+        return Err(ModelError::LabelCount {
+            channels: n,
+            expected: n / 3,
+            got: labels.len(),
+        });
+    }
+    check_labels(labels)?;
+    if !(rate_hz.is_finite() && rate_hz > 0.0) {
+        return Err(ModelError::InvalidRate { rate_hz });
+    }
+    if mean.len() != n {
+        return Err(ModelError::ShapeMismatch {
+            what: "mean",
+            expected: (n, 1),
+            got: (mean.len(), 1),
+        });
+    }
+    if let Some(row) = mean.iter().position(|v| !v.is_finite()) {
+        return Err(ModelError::NonFinite {
+            what: "mean",
+            row,
+            col: 0,
+        });
+    }
+    check_finite("mixing", mixing)?;
+    if report.channels != n {
+        return Err(ModelError::ReportMismatch {
+            what: "channels",
+            expected: n,
+            got: report.channels,
+        });
+    }
+    if report.components != m {
+        return Err(ModelError::ReportMismatch {
+            what: "components",
+            expected: m,
+            got: report.components,
+        });
+    }
+    Ok(())
+}
+
+fn check_labels(labels: &[String]) -> Result<(), ModelError> {
+    let mut seen: HashMap<&str, usize> = HashMap::with_capacity(labels.len());
+    for (index, label) in labels.iter().enumerate() {
+        if label.is_empty() {
+            return Err(ModelError::EmptyLabel { index });
+        }
+        if let Some(&first) = seen.get(label.as_str()) {
+            return Err(ModelError::DuplicateLabel {
+                label: label.clone(),
+                first,
+                second: index,
+            });
+        }
+        seen.insert(label, index);
+    }
+    Ok(())
+}
+
+fn check_finite(what: &'static str, matrix: &DMatrix<f64>) -> Result<(), ModelError> {
+    for (col, column) in matrix.column_iter().enumerate() {
+        if let Some(row) = column.iter().position(|v| !v.is_finite()) {
+            return Err(ModelError::NonFinite { what, row, col });
+        }
+    }
+    Ok(())
+}
+
+/// `M⁺` by SVD, refusing a rank-deficient `M` instead of silently truncating it: a dropped
+/// direction would make `W·M ≠ I` and edits of that component would vanish.
+fn pseudo_inverse(mixing: &DMatrix<f64>) -> Result<DMatrix<f64>, ModelError> {
+    let svd = mixing.clone().svd(true, true);
+    let largest = svd.singular_values.iter().copied().fold(0.0_f64, f64::max);
+    let smallest = svd
+        .singular_values
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    if smallest.is_nan() || smallest <= RANK_TOL * largest {
+        return Err(ModelError::RankDeficient {
+            smallest,
+            largest,
+            tol: RANK_TOL,
+        });
+    }
+    svd.pseudo_inverse(0.5 * smallest)
+        .map_err(|_| ModelError::RankDeficient {
+            smallest,
+            largest,
+            tol: RANK_TOL,
+        })
+}
+
+/// The two Penrose conditions that, given full column rank, pin `W` to `M⁺`: `W·M = I` (a
+/// left inverse) and `M·W` symmetric (the orthogonal projector, so off-model noise is
+/// projected orthogonally, not along some other left inverse's direction).
+fn check_pseudo_inverse(mixing: &DMatrix<f64>, unmixing: &DMatrix<f64>) -> Result<(), ModelError> {
+    let m = mixing.ncols();
+    let wm = unmixing * mixing;
+    let left = (wm - DMatrix::<f64>::identity(m, m)).amax();
+    if left.is_nan() || left > PINV_TOL {
+        return Err(ModelError::NotPseudoInverse {
+            check: "W·M = I",
+            residual: left,
+            tol: PINV_TOL,
+        });
+    }
+    let mw = mixing * unmixing;
+    let asym = (&mw - mw.transpose()).amax();
+    if asym.is_nan() || asym > PINV_TOL {
+        return Err(ModelError::NotPseudoInverse {
+            check: "M·W symmetric",
+            residual: asym,
+            tol: PINV_TOL,
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,209 @@
+//! Least-squares projection of a frame with missing markers:
+//! `u = argmin ‖M_o u − (x_o − mean_o)‖²` over the observed rows `o`, via the m x m normal
+//! equations `(M_oᵀ M_o) u = M_oᵀ (x_o − mean_o)` and a Cholesky factorisation, all in
+//! buffers sized at construction. f64 here: squaring `M` squares its condition number, which
+//! f32 would not survive.
+//!
+//! **Observability.** The Cholesky pivot `p_k` of a Gram matrix is the energy of column `k`
+//! not explained by columns `0..k`. Hiding rows can only shrink pivots (`M_oᵀM_o ≼ MᵀM`), so
+//! `p_k(observed) / p_k(full)` in `[0, 1]` is the share of component `k`'s independent
+//! footprint still visible. Its minimum over `k` is the frame's observability; below
+//! [`MIN_OBSERVABILITY`] the frame is ill-conditioned and is solved with a ridge that pulls
+//! the components toward a prior (the last good `u`, or the mean pose `u = 0`), so what the
+//! visible markers determine follows the data and what they cannot see holds still instead
+//! of exploding.
+
+/// Observability below which a masked frame is flagged ill-conditioned and regularised
+/// (1%: a component whose independent footprint is 99% hidden).
+pub const MIN_OBSERVABILITY: f64 = 1e-2;
+
+#[derive(Debug, Clone)]
+pub(crate) struct MaskedSolver {
+    m: usize,
+    /// `M` row-major (n x m), f64: the Gram update reads whole rows.
+    rows: Vec<f64>,
+    gram_full: Vec<f64>,
+    pivots_full: Vec<f64>,
+    gram: Vec<f64>,
+    factor: Vec<f64>,
+    pivots: Vec<f64>,
+    rhs: Vec<f64>,
+    sol: Vec<f64>,
+}
+
+/// What a masked solve found.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Solve {
+    pub observability: f64,
+    pub ill_conditioned: bool,
+}
+
+impl MaskedSolver {
+    /// `mixing_rows`: `M` row-major, n x m, of full column rank (the model guarantees it).
+    pub(crate) fn new(mixing_rows: Vec<f64>, m: usize) -> MaskedSolver {
+        let mut s = MaskedSolver {
+            m,
+            rows: mixing_rows,
+            gram_full: vec![0.0; m * m],
+            pivots_full: vec![0.0; m],
+            gram: vec![0.0; m * m],
+            factor: vec![0.0; m * m],
+            pivots: vec![0.0; m],
+            rhs: vec![0.0; m],
+            sol: vec![0.0; m],
+        };
+        for row in s.rows.chunks_exact(m) {
+            add_outer(&mut s.gram_full, row, m, 1.0);
+        }
+        s.factor.copy_from_slice(&s.gram_full);
+        let ok = cholesky(&mut s.factor, &mut s.pivots_full, m);
+        assert!(
+            ok,
+            "a full-rank mixing matrix has a positive definite Gram matrix"
+        );
+        s
+    }
+
+    /// Solves for `u` given the centred frame `c` (missing channels already zeroed, so
+    /// `Mᵀc = M_oᵀ c_o`), the per-channel `observed` mask with `hidden` channels hidden,
+    /// and the `prior` used when the frame is ill-conditioned.
+    pub(crate) fn solve(
+        &mut self,
+        rhs: impl Iterator<Item = f64>,
+        observed: &[bool],
+        hidden: usize,
+        prior: &[f32],
+        u: &mut [f32],
+    ) -> Solve {
+        let m = self.m;
+        for (r, v) in self.rhs.iter_mut().zip(rhs) {
+            *r = v;
+        }
+        self.build_gram(observed, hidden);
+        self.factor.copy_from_slice(&self.gram);
+        let ok = cholesky(&mut self.factor, &mut self.pivots, m);
+        let observability = if ok {
+            self.pivots
+                .iter()
+                .zip(&self.pivots_full)
+                .map(|(p, f)| p / f)
+                .fold(1.0, f64::min)
+        } else {
+            0.0
+        };
+        let ill_conditioned = observability < MIN_OBSERVABILITY;
+        if ill_conditioned {
+            self.regularise(prior);
+        }
+        solve_factored(&self.factor, &self.rhs, &mut self.sol, m);
+        for (ui, s) in u.iter_mut().zip(&self.sol) {
+            *ui = *s as f32;
+        }
+        Solve {
+            observability: observability.max(0.0),
+            ill_conditioned,
+        }
+    }
+
+    /// `M_oᵀ M_o`, by downdating the full Gram with the hidden rows when they are the
+    /// minority (cheap for a few occluded markers) and by summing the observed rows otherwise
+    /// (the downdate would cancel most of the full Gram and lose digits).
+    fn build_gram(&mut self, observed: &[bool], hidden: usize) {
+        let m = self.m;
+        let downdate = hidden * 2 <= observed.len();
+        if downdate {
+            self.gram.copy_from_slice(&self.gram_full);
+        } else {
+            self.gram.fill(0.0);
+        }
+        for (row, &obs) in self.rows.chunks_exact(m).zip(observed) {
+            if downdate && !obs {
+                add_outer(&mut self.gram, row, m, -1.0);
+            } else if !downdate && obs {
+                add_outer(&mut self.gram, row, m, 1.0);
+            }
+        }
+    }
+
+    /// Ridge toward `prior`: `(G + λD) u = b + λD prior` with `D = diag(MᵀM)`, `λ =`
+    /// [`MIN_OBSERVABILITY`]. Positive definite whatever is hidden, since `D > 0`.
+    fn regularise(&mut self, prior: &[f32]) {
+        let m = self.m;
+        self.factor.copy_from_slice(&self.gram);
+        for (k, (r, &p)) in self.rhs.iter_mut().zip(prior).enumerate() {
+            let d = MIN_OBSERVABILITY * self.gram_full[k * m + k];
+            self.factor[k * m + k] += d;
+            *r += d * f64::from(p);
+        }
+        let ok = cholesky(&mut self.factor, &mut self.pivots, m);
+        debug_assert!(ok, "G + λD is positive definite for λ > 0 and D > 0");
+    }
+}
+
+/// `g += sign · r rᵀ`, lower triangle only (the factorisation reads nothing else).
+fn add_outer(g: &mut [f64], r: &[f64], m: usize, sign: f64) {
+    for i in 0..m {
+        let ri = sign * r[i];
+        let gi = &mut g[i * m..i * m + i + 1];
+        for (gij, rj) in gi.iter_mut().zip(&r[..=i]) {
+            *gij += ri * rj;
+        }
+    }
+}
+
+/// In-place lower Cholesky `A = L Lᵀ` of a row-major m x m matrix, reading only the lower
+/// triangle; `pivots[j] = L_jj²`. Returns false at the first non-positive pivot.
+fn cholesky(a: &mut [f64], pivots: &mut [f64], m: usize) -> bool {
+    for j in 0..m {
+        let (head, below) = a.split_at_mut((j + 1) * m);
+        let row_j = &mut head[j * m..];
+        let d = row_j[j] - row_j[..j].iter().map(|v| v * v).sum::<f64>();
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        pivots[j] = d;
+        let ljj = d.sqrt();
+        row_j[j] = ljj;
+        let row_j = &head[j * m..];
+        for row_i in below.chunks_exact_mut(m) {
+            let s: f64 = row_i[..j].iter().zip(&row_j[..j]).map(|(x, y)| x * y).sum();
+            row_i[j] = (row_i[j] - s) / ljj;
+        }
+    }
+    true
+}
+
+/// Solves `L Lᵀ x = b` with the factor from [`cholesky`].
+fn solve_factored(l: &[f64], b: &[f64], x: &mut [f64], m: usize) {
+    for i in 0..m {
+        let s: f64 = l[i * m..i * m + i]
+            .iter()
+            .zip(&x[..i])
+            .map(|(a, y)| a * y)
+            .sum();
+        x[i] = (b[i] - s) / l[i * m + i];
+    }
+    for i in (0..m).rev() {
+        let s: f64 = ((i + 1)..m).map(|k| l[k * m + i] * x[k]).sum();
+        x[i] = (x[i] - s) / l[i * m + i];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cholesky_solves_a_known_system() {
+        // A = [[4, 2], [2, 3]], b = A [1, -2] = [0, -4]
+        let mut a = vec![4.0, 0.0, 2.0, 3.0];
+        let mut piv = vec![0.0; 2];
+        assert!(cholesky(&mut a, &mut piv, 2));
+        assert_eq!(piv, vec![4.0, 2.0]);
+        let mut x = vec![0.0; 2];
+        solve_factored(&a, &[0.0, -4.0], &mut x, 2);
+        assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] + 2.0).abs() < 1e-12);
+        let mut singular = vec![1.0, 0.0, 1.0, 1.0];
+        assert!(!cholesky(&mut singular, &mut piv, 2));
+    }
+}
