@@ -10,6 +10,8 @@ pub mod c3d;
 pub mod csv;
 pub mod error;
 pub mod format;
+pub mod session;
+pub mod synth;
 pub mod take;
 pub mod trc;
 
