@@ -77,22 +77,31 @@ fn animface_takes_load_with_their_documented_frame_counts() {
         );
         return;
     }
+    // Walk the folder so a new or replaced take that fails to load is noticed too.
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "trc") {
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            let take = replay::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(
+                (take.n_markers(), take.rate_hz, take.first_frame),
+                (41, 60.0, 1),
+                "{name}"
+            );
+            assert!(take.missing.iter().all(|&m| !m), "{name} has gaps");
+            found.push((name, take.n_frames()));
+        }
+    }
+    found.sort();
     let expected = [
         ("CheeksMoCap.trc", 1499),
         ("EyebrowsMoCap.trc", 902),
         ("JawMoCap.trc", 1590),
         ("NoseMoCap.trc", 962),
     ];
-    for (name, frames) in expected {
-        let take = replay::load(&dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(take.n_frames(), frames, "{name}");
-        assert_eq!(
-            (take.n_markers(), take.rate_hz, take.first_frame),
-            (41, 60.0, 1),
-            "{name}"
-        );
-        assert!(take.missing.iter().all(|&m| !m), "{name} has gaps");
-    }
+    let expected: Vec<(String, usize)> = expected.iter().map(|&(n, f)| (n.into(), f)).collect();
+    assert_eq!(found, expected, "frame counts per take (SOURCE.txt)");
     // A whole real take survives both writers exactly.
     let nose = replay::load(&dir.join("NoseMoCap.trc")).unwrap();
     for format in [Format::Trc, Format::Csv] {
