@@ -1,0 +1,387 @@
+//! Interpretation of the independent components (section 4 of the method): the emotion distance
+//! of paired takes, the region metrics, and the labelling rule.
+//!
+//! Component series are frames x m, row-major `f64`.
+//!
+//! - [`emotion_distance`]: for pairs of takes with the same sentence and different emotions, align
+//!   each pair by DTW and take the RMS difference of every component over all aligned samples
+//!   (`d_emotion,j`, section 4.2).
+//! - [`region_distance`]: `d_region,i = d(x_{E∪{i}}, x_all) − d(x_E, x_all)` on one region's
+//!   markers (Eq. 3–4), computed exactly from the region's Gram matrix `M_Rᵀ M_R`, so no marker
+//!   motion is reconstructed.
+//! - [`label`]: roles from the metrics, with the thresholds in [`LabelRules`].
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use crate::dtw::{self, DtwError};
+use crate::model::Role;
+
+/// Why the metrics could not be computed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InterpretError {
+    /// A series is not a whole number of m-component frames.
+    #[error("component series of {len} values is not a whole number of {m}-component frames")]
+    BadSeries {
+        /// Values in the series.
+        len: usize,
+        /// Components.
+        m: usize,
+    },
+    /// A region holds a marker outside the model.
+    #[error("region marker {marker} out of range for {markers} markers")]
+    BadMarker {
+        /// The marker index.
+        marker: usize,
+        /// Markers in the model.
+        markers: usize,
+    },
+    /// A region holds no marker.
+    #[error("region has no markers")]
+    EmptyRegion,
+    /// Alignment failed.
+    #[error("dtw: {0}")]
+    Dtw(#[from] DtwError),
+}
+
+/// `d_emotion` and what it was computed from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EmotionDistance {
+    /// `d_emotion,j` per component.
+    pub per_component: Vec<f64>,
+    /// Aligned samples per pair (`q_i`).
+    pub aligned_samples: Vec<usize>,
+}
+
+fn frames_of(series: &[f64], m: usize) -> Result<usize, InterpretError> {
+    if m == 0 || series.len() % m != 0 {
+        return Err(InterpretError::BadSeries {
+            len: series.len(),
+            m,
+        });
+    }
+    Ok(series.len() / m)
+}
+
+/// Each component minus its mean over the take: an emotion level that is constant within a take
+/// shifts every DTW cell of a pair equally at best, and biases the path at worst, so alignment
+/// looks at the motion around the level.
+fn demeaned(series: &[f64], m: usize, frames: usize) -> Vec<f64> {
+    let mut mean = vec![0.0; m];
+    for row in series.chunks_exact(m) {
+        for (acc, v) in mean.iter_mut().zip(row) {
+            *acc += v / frames as f64;
+        }
+    }
+    series
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v - mean[i % m])
+        .collect()
+}
+
+/// `d_emotion,j` over pairs of component series of the same sentence in two emotions.
+///
+/// `band` is the DTW Sakoe-Chiba radius in frames (`None`: unconstrained).
+///
+/// # Errors
+/// A series of the wrong shape, or an alignment failure (empty or non-finite series).
+pub fn emotion_distance(
+    pairs: &[(&[f64], &[f64])],
+    m: usize,
+    band: Option<usize>,
+) -> Result<EmotionDistance, InterpretError> {
+    let mut sum = vec![0.0; m];
+    let mut aligned_samples = Vec::with_capacity(pairs.len());
+    for (a, b) in pairs {
+        let (na, nb) = (frames_of(a, m)?, frames_of(b, m)?);
+        let alignment = dtw::align(&demeaned(a, m, na), &demeaned(b, m, nb), m, band)?;
+        for &(i, j) in &alignment.path {
+            for (k, acc) in sum.iter_mut().enumerate() {
+                let d = a[i * m + k] - b[j * m + k];
+                *acc += d * d;
+            }
+        }
+        aligned_samples.push(alignment.path.len());
+    }
+    let total: usize = aligned_samples.iter().sum();
+    let per_component = sum
+        .iter()
+        .map(|s| (s / total.max(1) as f64).sqrt())
+        .collect();
+    Ok(EmotionDistance {
+        per_component,
+        aligned_samples,
+    })
+}
+
+/// `d_region,i` for every component `i` (Eq. 4), given the emotion subset `emotion` (`E`, may be
+/// empty) and the region's marker indices.
+///
+/// The distance of Eq. 3 averages the squared 3-D marker distance over the region's `r` markers
+/// and all frames of all takes, then takes the square root.
+///
+/// # Errors
+/// Bad series shape, an empty region or a marker outside the model.
+pub fn region_distance(
+    mixing: &DMatrix<f64>,
+    takes: &[&[f64]],
+    region: &[usize],
+    emotion: &[usize],
+) -> Result<Vec<f64>, InterpretError> {
+    let m = mixing.ncols();
+    let markers = mixing.nrows() / 3;
+    if region.is_empty() {
+        return Err(InterpretError::EmptyRegion);
+    }
+    if let Some(&marker) = region.iter().find(|&&r| r >= markers) {
+        return Err(InterpretError::BadMarker { marker, markers });
+    }
+    // Gram matrix of the region's rows: ||M_R w||² = wᵀ G w.
+    let mut gram = DMatrix::<f64>::zeros(m, m);
+    for &r in region {
+        for row in r * 3..r * 3 + 3 {
+            let line = mixing.row(row);
+            gram += line.transpose() * line;
+        }
+    }
+    let mut base = 0.0; // Σ_t ||v_t||², v_t = M_R (u_t with E zeroed)
+    let mut cross = vec![0.0; m]; // Σ_t u_i(t) (G w_t)_i
+    let mut power = vec![0.0; m]; // Σ_t u_i(t)²
+    let mut q = 0usize;
+    let mut w = nalgebra::DVector::<f64>::zeros(m);
+    let mut gw = nalgebra::DVector::<f64>::zeros(m);
+    for series in takes {
+        frames_of(series, m)?;
+        for row in series.chunks_exact(m) {
+            w.copy_from_slice(row);
+            for &e in emotion {
+                w[e] = 0.0;
+            }
+            gw.gemv(1.0, &gram, &w, 0.0);
+            base += w.dot(&gw);
+            for i in 0..m {
+                if !emotion.contains(&i) {
+                    cross[i] += row[i] * gw[i];
+                    power[i] += row[i] * row[i];
+                }
+            }
+            q += 1;
+        }
+    }
+    let norm = (q.max(1) * region.len()) as f64;
+    let d_e = (base / norm).max(0.0).sqrt();
+    Ok((0..m)
+        .map(|i| {
+            if emotion.contains(&i) {
+                return 0.0;
+            }
+            let with_i = base - 2.0 * cross[i] + gram[(i, i)] * power[i];
+            (with_i / norm).max(0.0).sqrt() - d_e
+        })
+        .collect())
+}
+
+/// Thresholds of the labelling rule. Defaults are the documented values.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LabelRules {
+    /// A component is emotion when its `d_emotion` is at least this multiple of the median
+    /// `d_emotion` (a clear peak). Default 2.0.
+    pub emotion_peak_ratio: f64,
+    /// …and at least this share of the largest `d_emotion` (several peaks allowed). Default 0.6.
+    pub emotion_share_of_max: f64,
+    /// A component belongs to a region when its `|d_region|` is at least this share of the
+    /// largest `|d_region|` of that region among the non-emotion components. Default 0.25.
+    pub region_share_of_max: f64,
+}
+
+impl Default for LabelRules {
+    fn default() -> LabelRules {
+        LabelRules {
+            emotion_peak_ratio: 2.0,
+            emotion_share_of_max: 0.6,
+            region_share_of_max: 0.25,
+        }
+    }
+}
+
+/// The emotion component(s): the clear peaks of `d_emotion` under `rules`.
+pub fn emotion_components(d_emotion: &[f64], rules: &LabelRules) -> Vec<usize> {
+    let mut sorted = d_emotion.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let median = match sorted.len() {
+        0 => return Vec::new(),
+        n if n % 2 == 1 => sorted[n / 2],
+        n => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+    };
+    let max = sorted[sorted.len() - 1];
+    (0..d_emotion.len())
+        .filter(|&j| {
+            let d = d_emotion[j];
+            d > 0.0
+                && d >= rules.emotion_peak_ratio * median
+                && d >= rules.emotion_share_of_max * max
+        })
+        .collect()
+}
+
+/// Roles from the metrics. `regions` holds `(role, d_region per component)` for the regions that
+/// decide roles (mouth → speech, eyebrows, eyelids). Each non-emotion component takes the region
+/// where its `|d_region|`, relative to that region's largest, is highest — if that relative value
+/// reaches `rules.region_share_of_max`; otherwise it is `Other`.
+pub fn label(
+    m: usize,
+    emotion: &[usize],
+    regions: &[(Role, &[f64])],
+    rules: &LabelRules,
+) -> Vec<Role> {
+    let maxima: Vec<f64> = regions
+        .iter()
+        .map(|(_, d)| {
+            (0..m)
+                .filter(|i| !emotion.contains(i))
+                .map(|i| d[i].abs())
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    (0..m)
+        .map(|i| {
+            if emotion.contains(&i) {
+                return Role::Emotion;
+            }
+            let mut best = (Role::Other, 0.0);
+            for ((role, d), &max) in regions.iter().zip(&maxima) {
+                let rel = if max > 0.0 { d[i].abs() / max } else { 0.0 };
+                if rel >= rules.region_share_of_max && rel > best.1 {
+                    best = (*role, rel);
+                }
+            }
+            best.0
+        })
+        .collect()
+}
+
+/// Mean of component `k` over a set of takes (frames x m series): an emotion level.
+pub fn component_mean(takes: &[&[f64]], m: usize, k: usize) -> Option<f64> {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for series in takes {
+        for row in series.chunks_exact(m) {
+            sum += row[k];
+            n += 1;
+        }
+    }
+    (n > 0).then(|| sum / n as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Direct evaluation of Eq. 3–4 by reconstructing the region's markers.
+    fn region_brute(
+        mixing: &DMatrix<f64>,
+        series: &[f64],
+        region: &[usize],
+        e: &[usize],
+    ) -> Vec<f64> {
+        let m = mixing.ncols();
+        let frames = series.len() / m;
+        let d = |subset: &dyn Fn(usize) -> bool| {
+            let mut acc = 0.0;
+            for t in 0..frames {
+                for &r in region {
+                    for row in r * 3..r * 3 + 3 {
+                        let diff: f64 = (0..m)
+                            .filter(|&k| !subset(k))
+                            .map(|k| mixing[(row, k)] * series[t * m + k])
+                            .sum();
+                        acc += diff * diff;
+                    }
+                }
+            }
+            (acc / (frames * region.len()) as f64).sqrt()
+        };
+        let d_e = d(&|k| e.contains(&k));
+        (0..m)
+            .map(|i| {
+                if e.contains(&i) {
+                    0.0
+                } else {
+                    d(&|k| e.contains(&k) || k == i) - d_e
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn region_metric_matches_direct_reconstruction() {
+        let m = 4;
+        let mixing = DMatrix::from_fn(5 * 3, m, |r, c| ((r * 7 + c * 3) % 11) as f64 - 5.0);
+        let series: Vec<f64> = (0..50 * m)
+            .map(|i| ((i * 13 % 17) as f64 - 8.0) / 3.0)
+            .collect();
+        for e in [vec![], vec![2]] {
+            let fast = region_distance(&mixing, &[&series], &[1, 3], &e).expect("valid");
+            let slow = region_brute(&mixing, &series, &[1, 3], &e);
+            for (f, s) in fast.iter().zip(&slow) {
+                assert!((f - s).abs() < 1e-9, "{f} vs {s}");
+            }
+        }
+    }
+
+    #[test]
+    fn emotion_distance_peaks_on_the_offset_component() {
+        // Component 1 carries a constant offset between the takes; the others are the same
+        // motion at a different speed.
+        let m = 3;
+        let make = |n: usize, level: f64| -> Vec<f64> {
+            (0..n)
+                .flat_map(|t| {
+                    let s = t as f64 / n as f64 * 12.0;
+                    [s.sin(), level + 0.1 * (2.0 * s).cos(), (0.5 * s).cos()]
+                })
+                .collect()
+        };
+        let a = make(200, 1.0);
+        let b = make(240, -1.0);
+        let d = emotion_distance(&[(&a, &b)], m, Some(40)).expect("valid");
+        assert!(d.per_component[1] > 1.9, "{:?}", d.per_component);
+        assert!(
+            d.per_component[0] < 0.2 && d.per_component[2] < 0.2,
+            "{:?}",
+            d.per_component
+        );
+        assert_eq!(
+            emotion_components(&d.per_component, &LabelRules::default()),
+            vec![1]
+        );
+    }
+
+    #[test]
+    fn labels_follow_the_largest_relative_region_influence() {
+        let mouth = [-3.0, -0.1, -2.5, -0.05, 0.0];
+        let brows = [-0.2, -1.5, -0.1, -0.1, 0.0];
+        let lids = [-0.1, -0.3, -0.1, -0.9, 0.0];
+        let regions = [
+            (Role::Speech, &mouth[..]),
+            (Role::Eyebrows, &brows[..]),
+            (Role::Eyelids, &lids[..]),
+        ];
+        let roles = label(5, &[4], &regions, &LabelRules::default());
+        assert_eq!(
+            roles,
+            vec![
+                Role::Speech,
+                Role::Eyebrows,
+                Role::Speech,
+                Role::Eyelids,
+                Role::Emotion
+            ]
+        );
+    }
+
+    #[test]
+    fn no_clear_peak_means_no_emotion_component() {
+        assert!(emotion_components(&[1.0, 1.1, 0.9, 1.2], &LabelRules::default()).is_empty());
+    }
+}
