@@ -55,6 +55,9 @@ pub enum ReadError {
     /// The file declares units that cannot be converted to millimetres.
     #[error("unknown units {0:?} (expected mm, cm or m)")]
     UnknownUnits(String),
+    /// A C3D file is damaged or inconsistent; the error names what.
+    #[error(transparent)]
+    C3d(#[from] crate::c3d::C3dError),
     /// The content parsed but breaks a take invariant.
     #[error(transparent)]
     Invalid(#[from] TakeError),
@@ -150,7 +153,9 @@ pub enum ReadError {
         frames: usize,
     },
     /// The time column does not advance evenly enough to derive a frame rate.
-    #[error("line {line}: time step {step_s} s is not within 0.5-1.5x the mean step {mean_step_s} s")]
+    #[error(
+        "line {line}: time step {step_s} s is not within 0.5-1.5x the mean step {mean_step_s} s"
+    )]
     UnevenTime {
         /// 1-based line number of the later row.
         line: usize,
@@ -173,8 +178,13 @@ pub enum WriteError {
     /// The take cannot be represented in the target format; the text says why.
     #[error("{0}")]
     Unrepresentable(String),
+    /// The take exceeds what a C3D file can hold.
+    #[error(transparent)]
+    C3dLimit(#[from] crate::c3d::C3dLimitError),
     /// A marker label holds a character the text format uses as a separator.
-    #[error("marker label {label:?} contains {forbidden:?}, which {format} cannot hold in a label")]
+    #[error(
+        "marker label {label:?} contains {forbidden:?}, which {format} cannot hold in a label"
+    )]
     LabelUnrepresentable {
         /// The format being written (`trc`, `csv`).
         format: &'static str,

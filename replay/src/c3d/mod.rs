@@ -1,0 +1,103 @@
+//! C3D takes: read through the `c3dio` crate with our own validation and a fallback decoder,
+//! written by our own Intel float32 writer.
+//!
+//! Reading checks what c3dio does not: the header's frame range against POINT:FRAMES and the
+//! file length, POINT:USED against the header, the units (m and cm become mm). A sample is
+//! missing when its xyz is exactly (0, 0, 0) or its residual word is negative; the sign is taken
+//! from the raw word because c3dio reads the residual byte as signed. When c3dio refuses a file
+//! (e.g. ANALOG:OFFSET stored as float), panics, or sees no points (a header-only file with an
+//! empty parameter section), the points are decoded by our own parser from the header and
+//! whatever parameters there are, with generated labels `M001`, `M002`... where none are stored.
+//!
+//! Writing produces what strict readers (ezc3d, py-c3d) accept: see [`write`].
+
+mod binary;
+mod decode;
+mod error;
+mod layout;
+mod params;
+mod write;
+
+use std::io::Read;
+
+pub use binary::Processor;
+pub use decode::Decoder;
+pub use error::{C3dError, C3dLimitError};
+pub use write::write;
+
+use crate::error::ReadError;
+use crate::Take;
+
+/// What [`read_with_info`] learned about a file besides the take itself.
+#[derive(Debug, Clone, PartialEq)]
+pub struct C3dInfo {
+    /// The processor type the file was written on.
+    pub processor: Processor,
+    /// Whether points were stored as float32 (otherwise scaled int16).
+    pub float: bool,
+    /// Which decoder produced the values.
+    pub decoder: Decoder,
+    /// Why c3dio was not used, when it was not.
+    pub c3dio_error: Option<String>,
+    /// Inconsistencies the file has but that did not stop reading.
+    pub warnings: Vec<C3dError>,
+}
+
+/// Reads a C3D take.
+///
+/// # Errors
+/// [`ReadError::Io`] when the input fails, [`ReadError::C3d`] naming what is wrong with the file,
+/// [`ReadError::UnknownUnits`] for units other than mm, cm or m.
+pub fn read(mut input: impl Read) -> Result<Take, ReadError> {
+    let mut bytes = Vec::new();
+    input.read_to_end(&mut bytes)?;
+    read_with_info(&bytes).map(|(take, _)| take)
+}
+
+/// Reads a C3D take from bytes and reports how it was decoded.
+///
+/// # Errors
+/// As [`read`].
+pub fn read_with_info(bytes: &[u8]) -> Result<(Take, C3dInfo), ReadError> {
+    let (processor, header) = binary::parse_header(bytes)?;
+    let params = params::parse(bytes, header.parameter_block, header.data_block, processor)?;
+    let layout = layout::Layout::new(processor, &header, &params, bytes.len())?;
+    let own = decode::own(bytes, &layout);
+    let c3dio = decode::via_c3dio(bytes, &layout, header.parameter_block)
+        .and_then(|xyz| decode::agree(&xyz, &own, &layout).map(|()| xyz));
+    let (xyz, decoder, c3dio_error) = match c3dio {
+        Ok(xyz) => (xyz, Decoder::C3dio, None),
+        Err(e) => (own.xyz.clone(), Decoder::Fallback, Some(e)),
+    };
+    let take = build_take(&layout, &xyz, &own.invalid);
+    take.validate()?;
+    let info = C3dInfo {
+        processor,
+        float: layout.float,
+        decoder,
+        c3dio_error,
+        warnings: layout.warnings,
+    };
+    Ok((take, info))
+}
+
+/// Converts to millimetres and applies the missing rule: xyz exactly (0, 0, 0), a negative
+/// residual word, or a value that is not finite.
+fn build_take(l: &layout::Layout, xyz: &[f32], invalid: &[bool]) -> Take {
+    let mut take = Take::new(l.labels.clone(), l.rate_hz, l.first_frame);
+    take.source_units = l.units;
+    let to_mm = l.units.to_mm();
+    take.positions.reserve(xyz.len());
+    take.missing.reserve(invalid.len());
+    for (i, &bad) in invalid.iter().enumerate() {
+        let p = &xyz[i * 3..i * 3 + 3];
+        let gone = bad || p == [0.0; 3] || p.iter().any(|v| !v.is_finite());
+        if gone {
+            take.positions.extend([0.0; 3]);
+        } else {
+            take.positions.extend(p.iter().map(|v| v * to_mm));
+        }
+        take.missing.push(gone);
+    }
+    take
+}

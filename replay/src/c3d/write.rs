@@ -1,0 +1,288 @@
+//! The C3D writer: Intel float32, the parameter groups strict readers (ezc3d, py-c3d) require.
+
+use std::io::Write;
+
+use super::binary::{BLOCK, SIGNATURE};
+use super::error::C3dLimitError;
+use crate::error::WriteError;
+use crate::Take;
+
+/// Processor byte for Intel (83 + 1).
+const INTEL: u8 = 84;
+/// POINT:SCALE. Negative flags float32 storage; magnitude 1 so readers that multiply float
+/// values by |scale| anyway (py-c3d does for int16 only, some older tools always) get the same
+/// numbers, and residuals stay in millimetres.
+const SCALE: f32 = -1.0;
+/// Residual word of a missing sample: -1 is the C3D "invalid" flag.
+const MISSING_WORD: f32 = -1.0;
+/// Residual word of a present sample: no residual or camera information recorded.
+const PRESENT_WORD: f32 = 0.0;
+/// Strings per LABELS / DESCRIPTIONS parameter: a dimension is one byte.
+const LABELS_PER_PARAM: usize = 255;
+/// Markers POINT:USED (a signed 16-bit word) can count.
+const MAX_MARKERS: usize = i16::MAX as usize;
+/// The parameter section's block count is one byte.
+const MAX_PARAMETER_BLOCKS: usize = 255;
+
+/// Writes a take as C3D: Intel, float32 points (POINT:SCALE -1), millimetres.
+///
+/// Groups: POINT (USED, FRAMES, DATA_START, SCALE, RATE, UNITS "mm", LABELS and DESCRIPTIONS,
+/// continued by LABELS2... past 255 markers), an empty ANALOG group (USED 0) and FORCE_PLATFORM
+/// (USED 0), and TRIAL:ACTUAL_START_FIELD / ACTUAL_END_FIELD holding the true frame range as
+/// (low, high) 16-bit words. Takes longer than the header's 16-bit last frame allows are written
+/// as Vicon does: header last frame and POINT:FRAMES 65535, real count in POINT:LONG_FRAMES and
+/// TRIAL. A missing sample is xyz 0 with residual word -1. A present sample that is exactly
+/// (0, 0, 0) will read back as missing (C3D has no way to say otherwise).
+///
+/// # Errors
+/// [`WriteError::Invalid`] for a take that breaks its invariants, [`WriteError::C3dLimit`] for
+/// one C3D cannot hold (no frames, too many markers, a label over 255 bytes, a first frame
+/// outside 0..=65535), or an I/O error.
+pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
+    take.validate()?;
+    let frames = take.n_frames();
+    let range = FrameRange::new(take.first_frame, frames)?;
+    if take.n_markers() > MAX_MARKERS {
+        return Err(C3dLimitError::TooManyMarkers {
+            markers: take.n_markers(),
+            max: MAX_MARKERS,
+        }
+        .into());
+    }
+    if let Some(l) = take.labels.iter().find(|l| l.len() > 255) {
+        return Err(C3dLimitError::LabelTooLong {
+            label: l.clone(),
+            len: l.len(),
+        }
+        .into());
+    }
+    // The data block depends on the parameter size, which depends on DATA_START's value only
+    // through its fixed width: build once with a placeholder, then again with the real value.
+    let probe = parameters(take, &range, 0);
+    let blocks = probe.len().div_ceil(BLOCK);
+    if blocks > MAX_PARAMETER_BLOCKS {
+        return Err(C3dLimitError::TooManyParameterBlocks { blocks }.into());
+    }
+    let data_block = 2 + blocks;
+    let mut params = parameters(take, &range, data_block as u16);
+    params.resize(blocks * BLOCK, 0);
+    params[2] = blocks as u8;
+    out.write_all(&header(take, &range, data_block as u16))?;
+    out.write_all(&params)?;
+    write_frames(take, out)?;
+    // Pad the last data block: some readers expect whole blocks.
+    let data_len = frames * take.n_markers() * 16;
+    out.write_all(&vec![0u8; (BLOCK - data_len % BLOCK) % BLOCK])?;
+    Ok(())
+}
+
+/// The frame numbers as the header and TRIAL store them.
+struct FrameRange {
+    first: u32,
+    last: u32,
+    count: usize,
+}
+
+impl FrameRange {
+    fn new(first_frame: i64, frames: usize) -> Result<FrameRange, C3dLimitError> {
+        if frames == 0 {
+            return Err(C3dLimitError::NoFrames);
+        }
+        let first = u16::try_from(first_frame)
+            .map_err(|_| C3dLimitError::FirstFrameOutOfRange(first_frame))?;
+        let last = first_frame + frames as i64 - 1;
+        let last = u32::try_from(last).map_err(|_| C3dLimitError::TooManyFrames {
+            first: first_frame,
+            last,
+        })?;
+        Ok(FrameRange {
+            first: u32::from(first),
+            last,
+            count: frames,
+        })
+    }
+
+    /// The header's last frame, saturated at 65535.
+    fn header_last(&self) -> u16 {
+        u16::try_from(self.last).unwrap_or(u16::MAX)
+    }
+
+    /// POINT:FRAMES, saturated at 65535 (stored as the bit pattern of a signed word).
+    fn point_frames(&self) -> u16 {
+        u16::try_from(self.count).unwrap_or(u16::MAX)
+    }
+
+    fn long(&self) -> bool {
+        self.count > usize::from(u16::MAX) || self.last > u32::from(u16::MAX)
+    }
+}
+
+fn header(take: &Take, range: &FrameRange, data_block: u16) -> [u8; BLOCK] {
+    let mut h = [0u8; BLOCK];
+    h[0] = 2;
+    h[1] = SIGNATURE;
+    let mut put = |at: usize, b: &[u8]| h[at..at + b.len()].copy_from_slice(b);
+    put(2, &(take.n_markers() as u16).to_le_bytes());
+    put(4, &0u16.to_le_bytes()); // analog samples per frame
+    put(6, &(range.first as u16).to_le_bytes());
+    put(8, &range.header_last().to_le_bytes());
+    put(10, &0u16.to_le_bytes()); // maximum interpolation gap
+    put(12, &SCALE.to_le_bytes());
+    put(16, &data_block.to_le_bytes());
+    put(18, &0u16.to_le_bytes()); // analog samples per channel per frame
+    put(20, &(take.rate_hz as f32).to_le_bytes());
+    h
+}
+
+fn write_frames(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
+    let n = take.n_markers();
+    let mut buf = Vec::with_capacity(n * 16);
+    for f in 0..take.n_frames() {
+        buf.clear();
+        for m in 0..n {
+            match take.sample(f, m) {
+                Some(p) => {
+                    for v in p {
+                        buf.extend_from_slice(&v.to_le_bytes());
+                    }
+                    buf.extend_from_slice(&PRESENT_WORD.to_le_bytes());
+                }
+                None => {
+                    buf.extend_from_slice(&[0u8; 12]);
+                    buf.extend_from_slice(&MISSING_WORD.to_le_bytes());
+                }
+            }
+        }
+        out.write_all(&buf)?;
+    }
+    Ok(())
+}
+
+/// Group ids.
+const POINT: i8 = 1;
+const ANALOG: i8 = 2;
+const FORCE_PLATFORM: i8 = 3;
+const TRIAL: i8 = 4;
+
+fn parameters(take: &Take, range: &FrameRange, data_block: u16) -> Vec<u8> {
+    let mut w = Records::default();
+    w.buf.extend_from_slice(&[1, SIGNATURE, 0, INTEL]);
+    w.group(POINT, "POINT", "3-D point parameters");
+    w.int(POINT, "USED", &[take.n_markers() as u16]);
+    w.int(POINT, "FRAMES", &[range.point_frames()]);
+    if range.long() {
+        w.float(POINT, "LONG_FRAMES", &[range.count as f32]);
+    }
+    w.int(POINT, "DATA_START", &[data_block]);
+    w.float(POINT, "SCALE", &[SCALE]);
+    w.float(POINT, "RATE", &[take.rate_hz as f32]);
+    w.chars(POINT, "UNITS", &["mm".to_string()]);
+    let blanks = vec![String::new(); take.n_markers()];
+    for (k, chunk) in take.labels.chunks(LABELS_PER_PARAM).enumerate() {
+        let suffix = if k == 0 {
+            String::new()
+        } else {
+            (k + 1).to_string()
+        };
+        w.chars(POINT, &format!("LABELS{suffix}"), chunk);
+        let descriptions = &blanks[k * LABELS_PER_PARAM..k * LABELS_PER_PARAM + chunk.len()];
+        w.chars(POINT, &format!("DESCRIPTIONS{suffix}"), descriptions);
+    }
+    w.group(ANALOG, "ANALOG", "analog data parameters");
+    w.int(ANALOG, "USED", &[0]);
+    w.float(ANALOG, "RATE", &[take.rate_hz as f32]);
+    w.float(ANALOG, "GEN_SCALE", &[1.0]);
+    w.chars(ANALOG, "FORMAT", &["SIGNED".to_string()]);
+    w.int(ANALOG, "BITS", &[16]);
+    w.group(
+        FORCE_PLATFORM,
+        "FORCE_PLATFORM",
+        "force platform parameters",
+    );
+    w.int(FORCE_PLATFORM, "USED", &[0]);
+    w.group(TRIAL, "TRIAL", "trial parameters");
+    let words = |v: u32| [(v & 0xFFFF) as u16, (v >> 16) as u16];
+    w.int(TRIAL, "ACTUAL_START_FIELD", &words(range.first));
+    w.int(TRIAL, "ACTUAL_END_FIELD", &words(range.last));
+    w.finish()
+}
+
+/// Builds group and parameter records; each record's "offset to next" is patched when the next
+/// one starts, and the last stays 0, which ends the section.
+#[derive(Default)]
+struct Records {
+    buf: Vec<u8>,
+    /// Position of the previous record's offset word.
+    pending: Option<usize>,
+}
+
+impl Records {
+    fn start(&mut self, id: i8, name: &str) {
+        let here = self.buf.len();
+        if let Some(at) = self.pending {
+            let offset = (here - at) as u16;
+            self.buf[at..at + 2].copy_from_slice(&offset.to_le_bytes());
+        }
+        self.buf.push(name.len() as u8);
+        self.buf.push(id as u8);
+        self.buf.extend_from_slice(name.as_bytes());
+        self.pending = Some(self.buf.len());
+        self.buf.extend_from_slice(&[0, 0]);
+    }
+
+    fn group(&mut self, id: i8, name: &str, description: &str) {
+        self.start(-id, name);
+        self.buf.push(description.len() as u8);
+        self.buf.extend_from_slice(description.as_bytes());
+    }
+
+    fn param(&mut self, group: i8, name: &str, ty: i8, dims: &[u8], data: &[u8]) {
+        self.start(group, name);
+        self.buf.push(ty as u8);
+        self.buf.push(dims.len() as u8);
+        self.buf.extend_from_slice(dims);
+        self.buf.extend_from_slice(data);
+        self.buf.push(0); // no description
+    }
+
+    fn int(&mut self, group: i8, name: &str, values: &[u16]) {
+        let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let dims = if values.len() == 1 {
+            vec![]
+        } else {
+            vec![values.len() as u8]
+        };
+        self.param(group, name, 2, &dims, &data);
+    }
+
+    fn float(&mut self, group: i8, name: &str, values: &[f32]) {
+        let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let dims = if values.len() == 1 {
+            vec![]
+        } else {
+            vec![values.len() as u8]
+        };
+        self.param(group, name, 4, &dims, &data);
+    }
+
+    /// A character array of `strings.len()` strings, blank-padded to the longest (at least 1:
+    /// a zero dimension upsets some readers). Callers keep strings within 255 bytes.
+    fn chars(&mut self, group: i8, name: &str, strings: &[String]) {
+        let width = strings.iter().map(String::len).max().unwrap_or(0).max(1);
+        let mut data = Vec::with_capacity(width * strings.len());
+        for s in strings {
+            data.extend_from_slice(s.as_bytes());
+            data.resize(data.len() + width - s.len(), b' ');
+        }
+        let dims = if strings.len() == 1 {
+            vec![width as u8]
+        } else {
+            vec![width as u8, strings.len() as u8]
+        };
+        self.param(group, name, -1, &dims, &data);
+    }
+
+    fn finish(self) -> Vec<u8> {
+        self.buf
+    }
+}
