@@ -19,7 +19,8 @@
 //! - A blank or `NaN` cell means missing; a marker is missing in a frame if any of its three cells
 //!   is. `inf` or text is [`ReadError::BadCell`].
 //! - A row shorter than the header means its trailing markers are missing, as long as it stops at
-//!   a marker boundary (or ends in an empty cell); a row that stops after a marker's x or y value is
+//!   a marker boundary (or ends in an empty cell) and ends in a newline; a row that stops after a
+//!   marker's x or y value, or a short last row with no newline (a file cut off mid-write), is
 //!   [`ReadError::TruncatedRow`]. Non-empty cells beyond the header are
 //!   [`ReadError::ColumnCount`].
 //! - The first row's `Frame#` is the take's first frame; later rows must count up by one
@@ -62,22 +63,32 @@ pub fn read(input: impl Read) -> Result<Take, ReadError> {
     take.positions.reserve(reserve * 3);
     take.missing.reserve(reserve);
 
+    // The parser keeps its own copy of the labels (for error messages) so the take stays free
+    // to grow; a few dozen short strings.
     let row = RowParser {
-        labels: &take.labels,
+        labels: take.labels.clone(),
         scale: f64::from(header.units.to_mm()),
     };
     let mut xyz = vec![0.0f32; n * 3];
     let mut gone = vec![false; n];
     let mut next_frame = None;
     let mut first_frame = header.start_frame.unwrap_or(1);
-    while let Some((line, text)) = lines.next_non_blank()? {
-        let frame = row.parse(line, text, next_frame, &mut xyz, &mut gone)?;
+    let mut row_text = String::new();
+    // The row is copied out because `lines` stays borrowed while its text is.
+    while let Some(line) = lines.next_non_blank()?.map(|(line, text)| {
+        row_text.clear();
+        row_text.push_str(text);
+        line
+    }) {
+        // A short row is read as trailing missing markers, unless it is an unterminated last
+        // line: then the file was cut off and those markers were lost, not missing.
+        let complete = lines.terminated();
+        let frame = row.parse(line, &row_text, complete, next_frame, &mut xyz, &mut gone)?;
         if next_frame.is_none() {
             first_frame = frame;
         }
         next_frame = Some(frame.wrapping_add(1));
-        // Field-wise push: the parser borrows `take.labels` meanwhile.
-        take_push(&mut take.positions, &mut take.missing, &xyz, &gone);
+        take.push_frame(&xyz, &gone);
     }
     take.first_frame = first_frame;
     if take.n_frames() != header.num_frames {
@@ -90,30 +101,19 @@ pub fn read(input: impl Read) -> Result<Take, ReadError> {
     Ok(take)
 }
 
-/// Appends one frame to the take's buffers, zeroing missing samples as [`Take`] requires.
-fn take_push(positions: &mut Vec<f32>, missing: &mut Vec<bool>, xyz: &[f32], gone: &[bool]) {
-    for (m, &g) in gone.iter().enumerate() {
-        if g {
-            positions.extend_from_slice(&[0.0; 3]);
-        } else {
-            positions.extend_from_slice(&xyz[m * 3..m * 3 + 3]);
-        }
-    }
-    missing.extend_from_slice(gone);
-}
-
 /// Parses data rows against the header's markers.
-struct RowParser<'a> {
-    labels: &'a [String],
+struct RowParser {
+    labels: Vec<String>,
     scale: f64,
 }
 
-impl RowParser<'_> {
+impl RowParser {
     /// Parses one data row into `xyz` (mm) and `gone`, returning its frame number.
     fn parse(
         &self,
         line: usize,
         text: &str,
+        complete: bool,
         expected_frame: Option<i64>,
         xyz: &mut [f32],
         gone: &mut [bool],
@@ -137,14 +137,21 @@ impl RowParser<'_> {
                 cells[1],
             ));
         }
-        self.check_width(line, &cells, width)?;
+        self.check_width(line, &cells, width, complete)?;
         let data = cells.get(2..).unwrap_or(&[]);
-        text::parse_samples(line, data, 2, self.labels, self.scale, xyz, gone)?;
+        text::parse_samples(line, data, 2, &self.labels, self.scale, xyz, gone)?;
         Ok(frame)
     }
 
-    /// Extra cells must be empty; a short row must stop at a marker boundary or on an empty cell.
-    fn check_width(&self, line: usize, cells: &[&str], width: usize) -> Result<(), ReadError> {
+    /// Extra cells must be empty. A short row must stop at a marker boundary or on an empty
+    /// cell, and end in a newline (`complete`).
+    fn check_width(
+        &self,
+        line: usize,
+        cells: &[&str],
+        width: usize,
+        complete: bool,
+    ) -> Result<(), ReadError> {
         if cells.len() > width {
             if cells[width..].iter().any(|c| !c.trim().is_empty()) {
                 return Err(ReadError::ColumnCount {
@@ -153,10 +160,10 @@ impl RowParser<'_> {
                     found: cells.len(),
                 });
             }
-        } else {
+        } else if cells.len() < width {
             let data = cells.len() - 2;
             let last_blank = cells.last().is_some_and(|c| c.trim().is_empty());
-            if data % 3 != 0 && !last_blank {
+            if !complete || (data % 3 != 0 && !last_blank) {
                 return Err(ReadError::TruncatedRow {
                     line,
                     marker: self.labels[data / 3].clone(),

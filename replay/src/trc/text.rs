@@ -16,6 +16,8 @@ pub(crate) struct Lines<R> {
     input: R,
     text: String,
     number: usize,
+    /// Whether the last line read ended in `\n` (a cut-off file's last line does not).
+    terminated: bool,
 }
 
 impl<R: BufRead> Lines<R> {
@@ -25,6 +27,7 @@ impl<R: BufRead> Lines<R> {
             input,
             text: String::new(),
             number: 0,
+            terminated: true,
         }
     }
 
@@ -45,7 +48,8 @@ impl<R: BufRead> Lines<R> {
             return Ok(None);
         }
         self.number += 1;
-        if bytes.last() == Some(&b'\n') {
+        self.terminated = bytes.last() == Some(&b'\n');
+        if self.terminated {
             bytes.pop();
         }
         if bytes.last() == Some(&b'\r') {
@@ -58,6 +62,12 @@ impl<R: BufRead> Lines<R> {
             self.text.drain(..'\u{feff}'.len_utf8());
         }
         Ok(Some((self.number, &self.text)))
+    }
+
+    /// Whether the last line returned ended in a newline. Only the last line of a file can lack
+    /// one; with a short row, that is the mark of a file cut off mid-write.
+    pub(crate) fn terminated(&self) -> bool {
+        self.terminated
     }
 
     /// The next line that holds anything but whitespace, or `None` at the end of input.

@@ -55,6 +55,20 @@ fn trc_row_cut_inside_a_marker_is_a_truncated_row() {
         }
         other => panic!("expected TruncatedRow, got {other}"),
     }
+    // Cut exactly after marker 1 with no final newline: the cut, not missing markers.
+    let keep: Vec<&str> = last.split('\t').take(5).collect();
+    let cut = text.replace(&format!("{last}\n"), &keep.join("\t"));
+    assert!(matches!(
+        read_trc(&cut),
+        Err(ReadError::TruncatedRow {
+            line: 66,
+            cells: 0,
+            ..
+        })
+    ));
+    // The same short row with its newline means markers 2-41 are missing in that frame.
+    let take = read_trc(&format!("{cut}\n")).unwrap();
+    assert_eq!(take.frame_missing(59).iter().filter(|&&m| m).count(), 40);
 }
 
 #[test]
