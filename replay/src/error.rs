@@ -110,14 +110,15 @@ pub enum ReadError {
         /// Columns the row holds.
         found: usize,
     },
-    /// A row ends in the middle of one marker's x/y/z cells.
-    #[error("line {line}: row ends inside marker {marker:?} after {cells} of its 3 cells")]
+    /// A data row is cut off: it ends inside one marker's x/y/z cells, or it is a short last row
+    /// with no newline.
+    #[error("line {line}: row is cut off at marker {marker:?} after {cells} of its 3 cells")]
     TruncatedRow {
         /// 1-based line number.
         line: usize,
         /// Label of the cut marker.
         marker: String,
-        /// Cells of that marker present (1 or 2).
+        /// Cells of that marker present (0, 1 or 2).
         cells: usize,
     },
     /// Frame numbers are not consecutive.
