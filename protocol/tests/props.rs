@@ -1,0 +1,282 @@
+//! Property tests: round trips, the borrowed frame parser agreeing with rosc, and no panics
+//! on arbitrary or mutated input.
+
+use proptest::prelude::*;
+use protocol::rosc::{self, OscPacket, OscType};
+use protocol::*;
+
+fn frame_strategy() -> impl Strategy<Value = FrameBuf> {
+    (0usize..=130, any::<i32>(), any::<i64>())
+        .prop_flat_map(|(n, fnum, t)| {
+            (
+                prop::collection::vec(-5.0e3f32..5.0e3, n * 3),
+                prop::collection::vec(prop::bool::weighted(0.1), n),
+                Just((fnum, t)),
+            )
+        })
+        .prop_map(|(pos, missing, (fnum, t))| {
+            let mut f = FrameBuf::new();
+            f.set_frame(fnum, t, &pos).expect("finite positions");
+            for (i, m) in missing.into_iter().enumerate() {
+                f.set_missing(i, m);
+            }
+            f
+        })
+}
+
+/// Same numbers, NaN == NaN (missing markers).
+fn same_positions(a: &[f32], b: &[f32]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()))
+}
+
+/// What rosc makes of a frame message: (frame, time, mask, positions with NaN for missing).
+fn rosc_frame(bytes: &[u8]) -> Option<(i32, i64, Vec<u8>, Vec<f32>)> {
+    let (rest, OscPacket::Message(m)) = rosc::decoder::decode_udp(bytes).ok()? else {
+        return None;
+    };
+    if !rest.is_empty() || m.addr != "/mocap/frame" {
+        return None;
+    }
+    match m.args.as_slice() {
+        [OscType::Int(f), OscType::Long(t), OscType::Blob(mask), OscType::Blob(pos)] => {
+            let mut out: Vec<f32> = pos
+                .chunks_exact(4)
+                .map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]]))
+                .collect();
+            for (i, xyz) in out.chunks_exact_mut(3).enumerate() {
+                if mask[i / 8] >> (i % 8) & 1 == 1 {
+                    xyz.fill(f32::NAN);
+                }
+            }
+            Some((*f, *t, mask.clone(), out))
+        }
+        [OscType::Int(f), OscType::Long(t), floats @ ..] => {
+            let out: Vec<f32> = floats
+                .iter()
+                .map(|a| a.clone().float())
+                .collect::<Option<_>>()?;
+            let n = out.len() / 3;
+            let mut mask = vec![0u8; n.div_ceil(8)];
+            for (i, xyz) in out.chunks_exact(3).enumerate() {
+                if xyz.iter().all(|v| v.is_nan()) {
+                    mask[i / 8] |= 1 << (i % 8);
+                }
+            }
+            Some((*f, *t, mask, out))
+        }
+        _ => None,
+    }
+}
+
+/// Applies byte edits: (position, new byte) pairs, then a cut and an extension.
+fn mutate(mut bytes: Vec<u8>, edits: &[(usize, u8)], cut: usize, extra: &[u8]) -> Vec<u8> {
+    for &(at, b) in edits {
+        if !bytes.is_empty() {
+            let i = at % bytes.len();
+            bytes[i] = b;
+        }
+    }
+    bytes.truncate(bytes.len().saturating_sub(cut));
+    bytes.extend_from_slice(extra);
+    bytes
+}
+
+proptest! {
+    #[test]
+    fn frames_round_trip_and_agree_with_rosc(f in frame_strategy(), flat in any::<bool>()) {
+        let mut bytes = Vec::new();
+        if flat {
+            encode_frame_flat_into(&f, &mut bytes).expect("finite");
+        } else {
+            encode_frame_into(&f, &mut bytes).expect("finite");
+        }
+        let mut g = FrameBuf::new();
+        let h = decode_frame_into(&bytes, &mut g).expect("own encoding decodes");
+        prop_assert_eq!(h.frame_number, f.header().frame_number);
+        prop_assert_eq!(h.capture_time_us, f.header().capture_time_us);
+        prop_assert_eq!(h.missing_count, f.header().missing_count);
+        prop_assert_eq!(g.missing_mask(), f.missing_mask());
+        prop_assert!(same_positions(g.positions(), f.positions()));
+        let (rf, rt, rmask, rpos) = rosc_frame(&bytes).expect("rosc decodes our frame");
+        prop_assert_eq!((rf, rt), (h.frame_number, h.capture_time_us));
+        prop_assert_eq!(rmask.as_slice(), g.missing_mask());
+        prop_assert!(same_positions(&rpos, g.positions()));
+    }
+
+    /// Whenever the borrowed parser accepts mutated bytes, rosc reads the same numbers.
+    #[test]
+    fn accepted_mutants_agree_with_rosc(
+        f in frame_strategy(),
+        flat in any::<bool>(),
+        edits in prop::collection::vec((any::<usize>(), any::<u8>()), 0..4),
+        cut in prop_oneof![Just(0usize), 0usize..16],
+        extra in prop::collection::vec(any::<u8>(), 0..3),
+    ) {
+        let mut bytes = Vec::new();
+        if flat {
+            encode_frame_flat_into(&f, &mut bytes).expect("finite");
+        } else {
+            encode_frame_into(&f, &mut bytes).expect("finite");
+        }
+        let bytes = mutate(bytes, &edits, cut, &extra);
+        let mut g = FrameBuf::new();
+        if let Ok(h) = decode_frame_into(&bytes, &mut g) {
+            let (rf, rt, rmask, rpos) = rosc_frame(&bytes).expect("rosc accepts what we accept");
+            prop_assert_eq!((rf, rt), (h.frame_number, h.capture_time_us));
+            prop_assert_eq!(rmask.as_slice(), g.missing_mask());
+            prop_assert!(same_positions(&rpos, g.positions()));
+        }
+        // and the pre-scan's promise: what it passes, rosc decodes whole
+        if check_datagram(&bytes, &Limits::default()).is_ok() {
+            let (rest, _) = rosc::decoder::decode_udp(&bytes).expect("rosc decodes pre-scanned");
+            prop_assert!(rest.is_empty());
+        }
+    }
+
+    #[test]
+    fn nothing_panics_on_arbitrary_bytes(bytes in prop::collection::vec(any::<u8>(), 0..600)) {
+        let mut g = FrameBuf::with_max_markers(50);
+        let mut u = [0f32; 64];
+        let mut pos = [0f32; 300];
+        let _ = decode_frame_into(&bytes, &mut g);
+        let _ = decode_labels(&bytes);
+        let _ = decode_control(&bytes);
+        let _ = decode_reply(&bytes);
+        let _ = decode_part_into(&bytes, &mut pos);
+        let _ = decode_components_into(&bytes, &mut u);
+        if let Ok(msgs) = messages(&bytes, &Limits::default()) {
+            for m in msgs {
+                let _ = decode_frame_into(m.bytes, &mut g);
+                let _ = decode_control(m.bytes);
+            }
+        }
+    }
+
+    #[test]
+    fn labels_round_trip(
+        id in any::<i32>(),
+        names in prop::collection::hash_set("[A-Za-z0-9_.]{1,12}", 1..60),
+    ) {
+        let labels = Labels { layout_id: id, names: names.into_iter().collect() };
+        let mut out = Vec::new();
+        encode_labels_into(&labels, &mut out).expect("no nul");
+        prop_assert_eq!(decode_labels(&out), Ok(labels));
+    }
+
+    #[test]
+    fn control_and_replies_round_trip(c in control_strategy()) {
+        let mut out = Vec::new();
+        encode_control_into(&c, &mut out);
+        prop_assert_eq!(decode_control(&out), Ok(c.clone()));
+        if c != Control::Status {
+            encode_confirm_into(&c, &mut out);
+            prop_assert_eq!(decode_reply(&out), Ok(Reply::Confirm(c.clone())));
+        }
+        encode_error_into(c.address(), "bad value 3", &mut out);
+        let want = Reply::Error { address: c.address().to_string(), message: "bad value 3".into() };
+        prop_assert_eq!(decode_reply(&out), Ok(want));
+    }
+
+    #[test]
+    fn status_round_trips(counters in prop::collection::vec(("[a-z_]{1,20}", any::<i64>()), 0..20)) {
+        let mut out = Vec::new();
+        encode_status_into(&counters, &mut out);
+        prop_assert_eq!(decode_reply(&out), Ok(Reply::Status(counters)));
+    }
+
+    #[test]
+    fn compact_bundles_carry_frame_and_state(
+        f in frame_strategy(),
+        target in "[a-z]{0,20}",
+        amount in -2.0f32..2.0,
+    ) {
+        let mut out = Vec::new();
+        let n = encode_compact_into(&f, &target, amount, &mut out).expect("valid");
+        prop_assert_eq!(n, out.len());
+        let msgs: Vec<_> = messages(&out, &Limits::default()).expect("valid bundle").collect();
+        prop_assert_eq!(msgs.len(), 2);
+        let mut g = FrameBuf::new();
+        decode_frame_into(msgs[0].bytes, &mut g).expect("frame");
+        prop_assert!(same_positions(g.positions(), f.positions()));
+        let state = decode_osc(msgs[1].bytes).expect("state");
+        prop_assert_eq!(state.addr.as_str(), "/emoshift/state");
+        prop_assert_eq!(state.args, vec![OscType::String(target), OscType::Float(amount)]);
+    }
+
+    #[test]
+    fn flat_split_parts_fit_and_reassemble(f in frame_strategy(), max in 40usize..4096) {
+        let Ok(split) = FlatSplit::new(max) else {
+            prop_assert!(max < 60, "a part of {} bytes fits one marker", max);
+            return Ok(());
+        };
+        let n = f.marker_count();
+        let mut pos = vec![0f32; 3 * n];
+        let mut out = Vec::new();
+        let mut covered = 0;
+        for part in 0..split.part_count(n) {
+            let len = split.encode_part_into(&f, part, &mut out);
+            prop_assert!(len > 0 && len <= max, "part {} is {} bytes, max {}", part, len, max);
+            let h = decode_part_into(&out, &mut pos).expect("own part decodes");
+            prop_assert_eq!((h.first_marker, h.total_markers), (covered, n));
+            prop_assert_eq!(h.frame_number, f.header().frame_number);
+            covered += h.marker_count;
+        }
+        prop_assert_eq!(covered, n);
+        prop_assert_eq!(split.encode_part_into(&f, split.part_count(n), &mut out), 0);
+        prop_assert!(same_positions(&pos, f.positions()));
+    }
+
+    #[test]
+    fn components_round_trip_with_vmc(
+        u in prop::collection::vec(-3.0f32..3.0, 0..40),
+        names in prop::collection::vec(("[A-Za-z]{1,10}", 0usize..45), 0..6),
+    ) {
+        let mut out = Vec::new();
+        encode_components_into(&u, &names, &mut out).expect("no nul");
+        let msgs: Vec<_> = messages(&out, &Limits::default()).expect("valid").collect();
+        let mut got = [0f32; 64];
+        let n = decode_components_into(msgs[0].bytes, &mut got).expect("components");
+        prop_assert_eq!(&got[..n], u.as_slice());
+        let kept: Vec<_> = names.iter().filter(|(_, i)| *i < u.len()).collect();
+        if names.is_empty() {
+            prop_assert_eq!(msgs.len(), 1);
+            prop_assert_eq!(msgs[0].timetag, None);
+        } else {
+            prop_assert_eq!(msgs.len(), kept.len() + 2);
+            for ((name, i), m) in kept.iter().zip(&msgs[1..]) {
+                let v = decode_osc(m.bytes).expect("val");
+                prop_assert_eq!(v.addr.as_str(), "/VMC/Ext/Blend/Val");
+                prop_assert_eq!(v.args, vec![OscType::String(name.clone()), OscType::Float(u[*i])]);
+            }
+            prop_assert_eq!(msgs[msgs.len() - 1].address, "/VMC/Ext/Blend/Apply");
+        }
+    }
+}
+
+fn finite() -> impl Strategy<Value = f32> {
+    prop::num::f32::NORMAL | prop::num::f32::ZERO | prop::num::f32::SUBNORMAL
+}
+
+fn control_strategy() -> impl Strategy<Value = Control> {
+    let text = "[ -~]{0,30}";
+    prop_oneof![
+        text.prop_map(Control::Target),
+        finite().prop_map(Control::Amount),
+        finite().prop_map(|v| Control::Ramp(v.abs())),
+        (0..=i32::MAX as u32, finite())
+            .prop_map(|(component, value)| Control::Alpha { component, value }),
+        (0..=i32::MAX as u32, finite())
+            .prop_map(|(component, gain)| Control::Gain { component, gain }),
+        any::<bool>().prop_map(Control::Bypass),
+        (1..=u16::MAX, prop::sample::select(Profile::ALL.to_vec()))
+            .prop_map(|(port, profile)| Control::Subscribe { port, profile }),
+        (1..=u16::MAX).prop_map(|port| Control::Unsubscribe { port }),
+        text.prop_map(Control::ModelLoad),
+        text.prop_map(Control::RecordStart),
+        Just(Control::RecordStop),
+        Just(Control::Status),
+    ]
+}
