@@ -129,7 +129,9 @@ fn header(take: &Take, range: &FrameRange, data_block: u16) -> [u8; BLOCK] {
     put(10, &0u16.to_le_bytes()); // maximum interpolation gap
     put(12, &SCALE.to_le_bytes());
     put(16, &data_block.to_le_bytes());
-    put(18, &0u16.to_le_bytes()); // analog samples per channel per frame
+    // Analog samples per channel per frame: 1, matching ANALOG:RATE = POINT:RATE (py-c3d checks
+    // that this word equals their ratio even with no analog channels).
+    put(18, &1u16.to_le_bytes());
     put(20, &(take.rate_hz as f32).to_le_bytes());
     h
 }

@@ -1,0 +1,101 @@
+//! Every C3D file under `../shared/data/c3d-samples` (present on developer machines and in CI)
+//! loads with the marker count, frame range and rate that the folder's verified SOURCE.txt table
+//! gives, or fails with one clear line; none panics.
+
+use std::path::{Path, PathBuf};
+
+/// (file, markers, first frame, last frame, rate Hz rounded to 0.01 as the table prints it), from
+/// SOURCE.txt. sample_08's files hold
+/// Eb015pi's data with moved blocks.
+const TABLE: &[(&str, usize, i64, i64, f64)] = &[
+    ("sample_01/Eb015pi.c3d", 26, 1, 450, 50.0),
+    ("sample_01/Eb015pr.c3d", 26, 1, 450, 50.0),
+    ("sample_01/Eb015vi.c3d", 26, 1, 450, 50.0),
+    ("sample_01/Eb015vr.c3d", 26, 1, 450, 50.0),
+    ("sample_01/Eb015si.c3d", 26, 1, 450, 50.0),
+    ("sample_01/Eb015sr.c3d", 26, 1, 450, 50.0),
+    ("sample_02/pc_int.c3d", 36, 1, 89, 50.0),
+    ("sample_02/pc_real.c3d", 36, 1, 89, 50.0),
+    ("sample_02/dec_int.c3d", 36, 1, 89, 50.0),
+    ("sample_02/dec_real.c3d", 36, 1, 89, 50.0),
+    ("sample_02/sgi_int.c3d", 36, 1, 89, 50.0),
+    ("sample_02/sgi_real.c3d", 36, 1, 89, 50.0),
+    ("sample_08/TESTBPI.c3d", 26, 1, 450, 50.0),
+    ("sample_08/TESTCPI.c3d", 26, 1, 450, 50.0),
+    ("sample_08/TESTDPI.c3d", 26, 1, 450, 50.0),
+    ("sample_03/gait-raw.c3d", 27, 1, 142, 50.0),
+    ("sample_03/gait-pig-nz.c3d", 85, 300, 600, 120.0),
+    (
+        "sample_00/Vicon Motion Systems/pyCGM2 lower limb CGM24 Walking01.c3d",
+        171,
+        63,
+        555,
+        100.0,
+    ),
+    ("sample_13/Dance.c3d", 40, 1, 499, 65.05),
+    ("sample_20/phasespace_sample.c3d", 40, 1, 701, 30.0),
+    ("sample_29/Facial-Sing.c3d", 38, 1, 3000, 100.0),
+];
+
+fn samples_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/c3d-samples")
+}
+
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            walk(&path, out);
+        } else if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("c3d"))
+        {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn every_sample_file_matches_the_verified_table_or_fails_cleanly() {
+    let dir = samples_dir();
+    if !dir.is_dir() {
+        eprintln!("{} absent: nothing to walk", dir.display());
+        return;
+    }
+    let mut files = Vec::new();
+    walk(&dir, &mut files);
+    files.sort();
+    assert!(files.len() >= TABLE.len(), "found {} files", files.len());
+    let mut problems = Vec::new();
+    for path in &files {
+        let rel = path.strip_prefix(&dir).expect("walked under dir");
+        let rel = rel.to_string_lossy().replace('\\', "/");
+        let result = std::panic::catch_unwind(|| replay::load(path));
+        let Ok(result) = result else {
+            problems.push(format!("{rel}: panicked"));
+            continue;
+        };
+        let expected = TABLE.iter().find(|row| row.0 == rel);
+        match (result, expected) {
+            (Ok(take), Some(&(_, markers, first, last, rate))) => {
+                let got_last = take.first_frame + take.n_frames() as i64 - 1;
+                let got = (take.n_markers(), take.first_frame, got_last);
+                if got != (markers, first, last) || (take.rate_hz - rate).abs() > 0.005 {
+                    problems.push(format!(
+                        "{rel}: {got:?} at {} Hz, expected {:?} at {rate} Hz",
+                        take.rate_hz,
+                        (markers, first, last)
+                    ));
+                }
+            }
+            (Ok(_), None) => problems.push(format!("{rel}: not in the table")),
+            // A file the table does not list may fail, with one clear line.
+            (Err(e), None) if !e.to_string().is_empty() && !e.to_string().contains('\n') => {}
+            (Err(e), _) => problems.push(format!("{rel}: {e}")),
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
