@@ -1,1 +1,18 @@
-fn main() {}
+//! The `emoshift` binary: parses the command line, installs tracing, runs the command and maps its
+//! outcome to an exit code.
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    let cli = daemon::cli::Cli::parse();
+    daemon::logging::install();
+    match daemon::commands::run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("emoshift: error: {err:#}");
+            ExitCode::from(daemon::exit::code_for(&err))
+        }
+    }
+}

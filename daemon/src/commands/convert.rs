@@ -1,0 +1,20 @@
+//! `emoshift convert IN OUT`: read any supported format, write any other; gaps are kept.
+
+use anyhow::{Context, Result};
+
+use crate::cli::ConvertArgs;
+
+pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
+    let take = super::load_take(&args.input)?;
+    replay::save(&args.output, &take).with_context(|| format!("{}", args.output.display()))?;
+    let gaps: usize = take.missing.iter().filter(|&&m| m).count();
+    println!(
+        "wrote {}: {} markers, {} frames at {} Hz, {} missing samples",
+        args.output.display(),
+        take.n_markers(),
+        take.n_frames(),
+        take.rate_hz,
+        gaps
+    );
+    Ok(())
+}

@@ -1,0 +1,84 @@
+//! `emoshift info FILE [--json]`: what a take holds.
+
+use anyhow::Result;
+use serde::Serialize;
+
+use crate::cli::InfoArgs;
+
+#[derive(Debug, Serialize)]
+struct Info<'a> {
+    file: String,
+    markers: usize,
+    frames: usize,
+    rate_hz: f64,
+    first_frame: i64,
+    last_frame: i64,
+    duration_s: f64,
+    source_units: &'static str,
+    missing_samples: usize,
+    marker_list: Vec<MarkerInfo<'a>>,
+}
+
+#[derive(Debug, Serialize)]
+struct MarkerInfo<'a> {
+    label: &'a str,
+    missing: usize,
+}
+
+pub(crate) fn run(args: &InfoArgs) -> Result<()> {
+    let take = super::load_take(&args.file)?;
+    let per_marker = take.missing_per_marker();
+    let frames = take.n_frames();
+    let info = Info {
+        file: args.file.display().to_string(),
+        markers: take.n_markers(),
+        frames,
+        rate_hz: take.rate_hz,
+        first_frame: take.first_frame,
+        last_frame: take.first_frame + frames as i64 - 1,
+        duration_s: frames as f64 / take.rate_hz,
+        source_units: take.source_units.as_str(),
+        missing_samples: per_marker.iter().sum(),
+        marker_list: take
+            .labels
+            .iter()
+            .zip(&per_marker)
+            .map(|(label, &missing)| MarkerInfo { label, missing })
+            .collect(),
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+    } else {
+        print_text(&info);
+    }
+    Ok(())
+}
+
+fn print_text(info: &Info<'_>) {
+    println!("file:     {}", info.file);
+    println!("markers:  {}", info.markers);
+    println!(
+        "frames:   {} ({}..={}), {:.3} s",
+        info.frames, info.first_frame, info.last_frame, info.duration_s
+    );
+    println!("rate:     {} Hz", info.rate_hz);
+    println!("units:    {} (values shown in mm)", info.source_units);
+    let total = info.frames * info.markers;
+    let pct = if total == 0 {
+        0.0
+    } else {
+        100.0 * info.missing_samples as f64 / total as f64
+    };
+    println!("missing:  {} samples ({pct:.2} %)", info.missing_samples);
+    let width = info
+        .marker_list
+        .iter()
+        .map(|m| m.label.len())
+        .max()
+        .unwrap_or(5)
+        .max(5);
+    println!("  {:<width$}  missing", "label");
+    for m in &info.marker_list {
+        println!("  {:<width$}  {}", m.label, m.missing);
+    }
+}

@@ -1,0 +1,36 @@
+//! `emoshift synth`: write a paired synthetic session.
+
+use anyhow::{Context, Result};
+use replay::synth::{write_session, SynthParams};
+
+use crate::cli::SynthArgs;
+use crate::exit::UsageError;
+
+pub(crate) fn run(args: &SynthArgs) -> Result<()> {
+    let format = replay::Format::from_name(&args.format).ok_or_else(|| {
+        UsageError(format!(
+            "unknown format {:?} (expected c3d, trc or csv)",
+            args.format
+        ))
+    })?;
+    let params = SynthParams {
+        seed: args.seed,
+        sentences: args.sentences,
+        emotions: args.emotions.clone(),
+        rate_hz: args.rate,
+        head_motion: args.head_motion,
+    };
+    params.validate().map_err(|e| UsageError(e.to_string()))?;
+    let summary = write_session(&args.out, &params, format)
+        .with_context(|| format!("cannot write the session to {}", args.out.display()))?;
+    println!(
+        "wrote {} takes ({} frames, {} markers at {} Hz) to {}",
+        summary.takes.len(),
+        summary.total_frames,
+        summary.markers,
+        args.rate,
+        summary.dir.display()
+    );
+    println!("manifest: {}", summary.manifest.display());
+    Ok(())
+}
