@@ -5,7 +5,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use c3dio::C3d;
 
-use super::binary::{take2, take4, Processor, BLOCK};
+use super::binary::{take2, take4, Header, Processor, BLOCK};
 use super::layout::Layout;
 
 /// Which decoder produced the sample values.
@@ -68,7 +68,17 @@ fn residual_word(bytes: &[u8], at: usize, l: &Layout) -> i32 {
 /// `Err` with c3dio's complaint otherwise (a panic inside c3dio included). Residual signs are not
 /// taken from c3dio: it reads the residual byte as signed, which flags large valid residuals as
 /// invalid, so the caller keeps the raw words' signs.
-pub fn via_c3dio(bytes: &[u8], l: &Layout, param_block: usize) -> Result<Vec<f32>, String> {
+pub fn via_c3dio(bytes: &[u8], l: &Layout, h: &Header) -> Result<Vec<f32>, String> {
+    // c3dio allocates a grid of the header's frame range x points before reading any data; an
+    // out-of-memory abort cannot be caught, so a range the file cannot hold never reaches it.
+    let header_frames = usize::from(h.last_frame.saturating_sub(h.first_frame)) + 1;
+    if header_frames.saturating_mul(l.points) > bytes.len() / 8 {
+        return Err(format!(
+            "header frame range {}..{} is too large for c3dio",
+            h.first_frame, h.last_frame
+        ));
+    }
+    let param_block = h.parameter_block;
     let canonical = canonical_layout(bytes, l, param_block)?;
     let parsed = catch_unwind(AssertUnwindSafe(|| {
         C3d::from_bytes(&canonical).map_err(|e| format!("{e:?}"))

@@ -63,7 +63,7 @@ pub fn read_with_info(bytes: &[u8]) -> Result<(Take, C3dInfo), ReadError> {
     let params = params::parse(bytes, header.parameter_block, header.data_block, processor)?;
     let layout = layout::Layout::new(processor, &header, &params, bytes.len())?;
     let own = decode::own(bytes, &layout);
-    let c3dio = decode::via_c3dio(bytes, &layout, header.parameter_block)
+    let c3dio = decode::via_c3dio(bytes, &layout, &header)
         .and_then(|xyz| decode::agree(&xyz, &own, &layout).map(|()| xyz));
     let (xyz, decoder, c3dio_error) = match c3dio {
         Ok(xyz) => (xyz, Decoder::C3dio, None),
