@@ -19,7 +19,10 @@ fn golden_file_loads_with_its_contents() {
     let model = IcaModel::load(GOLDEN.as_bytes()).expect("golden file loads");
     assert_eq!(FORMAT_VERSION, 1);
     assert_eq!(model.labels(), &["forehead", "lip_upper", "lip_lower"]);
-    assert_eq!((model.channels(), model.markers(), model.components()), (9, 3, 2));
+    assert_eq!(
+        (model.channels(), model.markers(), model.components()),
+        (9, 3, 2)
+    );
     assert_eq!(model.rate_hz(), 120.0);
     assert_eq!(model.mean()[2], 1040.25);
     assert_eq!(model.mixing()[(7, 1)], -3.0);
@@ -49,7 +52,7 @@ fn save_load_round_trip_is_exact_for_awkward_floats() {
     let mut v = golden_value();
     // Values with 17 significant digits exercise exact float parsing.
     v["mean"][0] = json!(0.1 + 0.2);
-    v["mean"][3] = json!(-1234.567_890_123_456_7);
+    v["mean"][3] = json!(-1_234.567_890_123_456);
     let edited = load_value(&v).expect("still valid");
     let mut out = Vec::new();
     edited.save(&mut out).expect("vec writer");
@@ -84,7 +87,16 @@ fn version_is_checked_first() {
         v["format_version"] = json!(2);
         v["mixing"] = json!("a future layout");
     });
-    assert!(matches!(e, ModelError::UnsupportedVersion { found: 2, supported: 1 }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::UnsupportedVersion {
+                found: 2,
+                supported: 1
+            }
+        ),
+        "{e}"
+    );
     assert_eq!(
         e.to_string(),
         "model format version 2 is not supported (this build reads version 1)"
@@ -98,28 +110,121 @@ fn version_is_checked_first() {
 #[test]
 fn shapes_and_labels_are_checked() {
     let e = load_err(|v| v["mixing"][3] = json!([1.0, 2.0, 3.0]));
-    assert!(matches!(e, ModelError::RaggedRow { what: "mixing", row: 3, expected: 2, got: 3 }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::RaggedRow {
+                what: "mixing",
+                row: 3,
+                expected: 2,
+                got: 3
+            }
+        ),
+        "{e}"
+    );
     let e = load_err(|v| v["mean"] = json!([1.0, 2.0]));
-    assert!(matches!(e, ModelError::ShapeMismatch { what: "mean", expected: (9, 1), got: (2, 1) }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::ShapeMismatch {
+                what: "mean",
+                expected: (9, 1),
+                got: (2, 1)
+            }
+        ),
+        "{e}"
+    );
     let e = load_err(|v| v["unmixing"] = json!([vec![0.0; 9]]));
-    assert!(matches!(e, ModelError::ShapeMismatch { what: "unmixing", expected: (2, 9), got: (1, 9) }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::ShapeMismatch {
+                what: "unmixing",
+                expected: (2, 9),
+                got: (1, 9)
+            }
+        ),
+        "{e}"
+    );
     let e = load_err(|v| v["labels"] = json!(["a", "b"]));
-    assert!(matches!(e, ModelError::LabelCount { channels: 9, expected: 3, got: 2 }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::LabelCount {
+                channels: 9,
+                expected: 3,
+                got: 2
+            }
+        ),
+        "{e}"
+    );
     let e = load_err(|v| v["labels"][2] = json!("forehead"));
-    assert!(matches!(e, ModelError::DuplicateLabel { first: 0, second: 2, .. }), "{e}");
-    assert_eq!(e.to_string(), "marker label \"forehead\" appears twice, at 0 and 2");
+    assert!(
+        matches!(
+            e,
+            ModelError::DuplicateLabel {
+                first: 0,
+                second: 2,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert_eq!(
+        e.to_string(),
+        "marker label \"forehead\" appears twice, at 0 and 2"
+    );
     let e = load_err(|v| v["roles"] = json!(["speech"]));
-    assert!(matches!(e, ModelError::ShapeMismatch { what: "roles", expected: (2, 1), got: (1, 1) }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::ShapeMismatch {
+                what: "roles",
+                expected: (2, 1),
+                got: (1, 1)
+            }
+        ),
+        "{e}"
+    );
     let e = load_err(|v| v["report"]["components"] = json!(3));
-    assert!(matches!(e, ModelError::ReportMismatch { what: "components", expected: 2, got: 3 }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::ReportMismatch {
+                what: "components",
+                expected: 2,
+                got: 3
+            }
+        ),
+        "{e}"
+    );
 }
 
 #[test]
 fn emotion_component_and_unmixing_are_checked() {
     let e = load_err(|v| v["emotion"]["component"] = json!(2));
-    assert!(matches!(e, ModelError::ComponentOutOfRange { index: 2, components: 2, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::ComponentOutOfRange {
+                index: 2,
+                components: 2,
+                ..
+            }
+        ),
+        "{e}"
+    );
     let e = load_err(|v| v["unmixing"][0][1] = json!(0.5));
-    assert!(matches!(e, ModelError::NotPseudoInverse { check: "W·M = I", .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ModelError::NotPseudoInverse {
+                check: "W·M = I",
+                ..
+            }
+        ),
+        "{e}"
+    );
     let e = load_err(|v| v["rate_hz"] = json!(-120.0));
     assert!(matches!(e, ModelError::InvalidRate { .. }), "{e}");
 }
@@ -132,5 +237,8 @@ fn malformed_json_reports_line_and_column() {
     let wrong_type = GOLDEN.replace("\"rate_hz\": 120.0", "\"rate_hz\": \"fast\"");
     let e = IcaModel::load(wrong_type.as_bytes()).expect_err("type error");
     assert!(matches!(e, ModelError::Malformed { line: 4, .. }), "{e}");
-    assert!(e.to_string().starts_with("malformed model file at line 4"), "{e}");
+    assert!(
+        e.to_string().starts_with("malformed model file at line 4"),
+        "{e}"
+    );
 }

@@ -25,31 +25,21 @@ pub(crate) fn dot(a: &[f32], b: &[f32]) -> f32 {
     reduce(acc) + tail
 }
 
-/// Four dot products against one shared `x`: each load of `x` feeds four rows, halving the
-/// loads of the projection compared with four separate [`dot`] calls.
+/// Panel widths [`panel_gemv`] is instantiated for.
+pub(crate) const PANEL_WIDTHS: [usize; 4] = [8, 16, 24, 32];
+
+/// `u = Wᵀᵀ c` for `wt` = n rows of `K` (the transposed unmixing matrix, zero padded from
+/// `u.len()` to `K` columns): `acc += c_j · wt[j]`. With `K` known at compile time the
+/// accumulator lives in registers and the row update is a handful of vector multiply-adds.
 #[inline]
-pub(crate) fn dot4(rows: [&[f32]; 4], x: &[f32]) -> [f32; 4] {
-    const L: usize = 8;
-    let mut acc = [[0.0_f32; L]; 4];
-    let chunks = x.len() / L;
-    for c in 0..chunks {
-        let xs = &x[c * L..c * L + L];
-        for (acc_r, row) in acc.iter_mut().zip(rows) {
-            let rs = &row[c * L..c * L + L];
-            for i in 0..L {
-                acc_r[i] += rs[i] * xs[i];
-            }
+pub(crate) fn panel_gemv<const K: usize>(wt: &[f32], c: &[f32], u: &mut [f32]) {
+    let mut acc = [0.0_f32; K];
+    for (row, &cj) in wt.chunks_exact(K).zip(c) {
+        for i in 0..K {
+            acc[i] += cj * row[i];
         }
     }
-    let mut out = [0.0_f32; 4];
-    for (o, (acc_r, row)) in out.iter_mut().zip(acc.iter().zip(rows)) {
-        let mut tail = 0.0_f32;
-        for j in chunks * L..x.len() {
-            tail += row[j] * x[j];
-        }
-        *o = acc_r.iter().sum::<f32>() + tail;
-    }
-    out
+    u.copy_from_slice(&acc[..u.len()]);
 }
 
 fn reduce(acc: [f32; LANES]) -> f32 {
@@ -115,10 +105,14 @@ mod tests {
         let b: Vec<f32> = (0..n).map(|i| (i as f32 * 0.11).cos()).collect();
         let naive: f32 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
         assert!((dot(&a, &b) - naive).abs() < 1e-5);
-        let rows = [&a[..], &b[..], &a[..], &b[..]];
-        let d4 = dot4(rows, &b);
-        assert!((d4[0] - naive).abs() < 1e-5);
-        assert!((d4[1] - dot(&b, &b)).abs() < 1e-5);
+        // Wᵀ with 2 components padded to 8: u = [a·b, b·b].
+        let wt: Vec<f32> = (0..n)
+            .flat_map(|j| [a[j], b[j], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+            .collect();
+        let mut u = [0.0_f32; 2];
+        panel_gemv::<8>(&wt, &b, &mut u);
+        assert!((u[0] - naive).abs() < 1e-5);
+        assert!((u[1] - dot(&b, &b)).abs() < 1e-5);
         let mut y = b.clone();
         axpy4(
             [1.0, 2.0, 0.0, -1.0],

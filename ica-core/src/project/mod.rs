@@ -9,9 +9,13 @@
 //! `ε₃₂ · (|x| + cond(M)·|x − mean|)`, ~1e-4 mm for a face in millimetres a metre from the
 //! origin with a well-conditioned model: the f32 spacing of the raw coordinates dominates.
 //!
-//! **Layout.** `W` is m rows of n contiguous values and `M` is stored column-major, so both
-//! products are loops over contiguous memory (dot products for `W·c`, four-column axpys for
-//! `M·u`) that the compiler vectorises.
+//! **Layout.** Both products are loops over contiguous memory that the compiler vectorises
+//! without `unsafe` or target-specific code. `W·c` runs over `Wᵀ` stored as n rows of m
+//! values zero-padded to a fixed width (8, 16, 24 or 32): `u += c_j · Wᵀ[j]` with `u` held in
+//! a fixed-size accumulator, i.e. in registers (measured ~1.7x faster than m dot products,
+//! whose float reductions LLVM vectorises only two lanes wide). Models with more than 32
+//! components fall back to m rows of n and dot products. `M` is stored column-major, so
+//! `M·u` is a sum of column axpys, four columns per pass over the output.
 //!
 //! **Missing markers** (a `missing` mask, or any non-finite coordinate) are handled by
 //! least squares on the observed rows; see [`masked`] for the method and the
@@ -24,7 +28,7 @@ pub use masked::MIN_OBSERVABILITY;
 
 use crate::edit::FrameEdit;
 use crate::model::IcaModel;
-use kernels::{all_finite, axpy, axpy4, dot4, sub_into};
+use kernels::{all_finite, axpy, axpy4, panel_gemv, sub_into, PANEL_WIDTHS};
 use masked::MaskedSolver;
 
 /// A frame buffer of the wrong length. Small and `Copy`: returned per frame.
@@ -73,8 +77,11 @@ pub struct FrameStatus {
 pub struct Projector {
     channels: usize,
     components: usize,
-    /// `W`, m rows of n.
+    /// `W` as `Wᵀ` panel (n rows of `panel_width`, zero padded) when `m` fits a panel,
+    /// else m rows of n.
     unmixing: Vec<f32>,
+    /// 8, 16, 24 or 32; 0 for the row layout.
+    panel_width: usize,
     /// `M` column-major: column k is `mixing[k*n..(k+1)*n]`.
     mixing: Vec<f32>,
     mean: Vec<f32>,
@@ -89,9 +96,17 @@ impl Projector {
     pub fn new(model: &IcaModel) -> Projector {
         let (n, m) = model.mixing().shape();
         let w = model.unmixing();
-        let unmixing = (0..m)
-            .flat_map(|k| (0..n).map(move |j| w[(k, j)] as f32))
-            .collect();
+        let panel_width = PANEL_WIDTHS.iter().copied().find(|&k| k >= m).unwrap_or(0);
+        let unmixing = if panel_width > 0 {
+            let wt = |j: usize, k: usize| if k < m { w[(k, j)] as f32 } else { 0.0 };
+            (0..n)
+                .flat_map(|j| (0..panel_width).map(move |k| wt(j, k)))
+                .collect()
+        } else {
+            (0..m)
+                .flat_map(|k| (0..n).map(move |j| w[(k, j)] as f32))
+                .collect()
+        };
         // nalgebra is column-major already.
         let mixing = model.mixing().iter().map(|&v| v as f32).collect();
         let rows = (0..n)
@@ -101,6 +116,7 @@ impl Projector {
             channels: n,
             components: m,
             unmixing,
+            panel_width,
             mixing,
             mean: model.mean().iter().map(|&v| v as f32).collect(),
             centered: vec![0.0; n],
@@ -245,20 +261,19 @@ impl Projector {
         Ok(status)
     }
 
-    /// `u = W · centered`, four rows of `W` per pass over `centered`.
+    /// `u = W · centered`.
     fn project_centered(&self, u: &mut [f32]) {
-        let n = self.channels;
-        let c = &self.centered;
-        let mut rows = self.unmixing.chunks_exact(4 * n);
-        let mut outs = u.chunks_exact_mut(4);
-        for (block, o) in (&mut rows).zip(&mut outs) {
-            let (r0, rest) = block.split_at(n);
-            let (r1, rest) = rest.split_at(n);
-            let (r2, r3) = rest.split_at(n);
-            o.copy_from_slice(&dot4([r0, r1, r2, r3], c));
-        }
-        for (row, o) in rows.remainder().chunks_exact(n).zip(outs.into_remainder()) {
-            *o = kernels::dot(row, c);
+        let (w, c) = (&self.unmixing, &self.centered);
+        match self.panel_width {
+            8 => panel_gemv::<8>(w, c, u),
+            16 => panel_gemv::<16>(w, c, u),
+            24 => panel_gemv::<24>(w, c, u),
+            32 => panel_gemv::<32>(w, c, u),
+            _ => {
+                for (row, o) in w.chunks_exact(self.channels).zip(u.iter_mut()) {
+                    *o = kernels::dot(row, c);
+                }
+            }
         }
     }
 
