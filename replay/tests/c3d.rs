@@ -218,3 +218,42 @@ fn garbage_is_an_error_not_a_panic() {
         Err(ReadError::C3d(C3dError::TooShort { len: 32 }))
     ));
 }
+
+/// Rewrites the two-character POINT:UNITS value of a file our writer produced.
+fn with_units(bytes: &[u8], units: &[u8; 2]) -> Vec<u8> {
+    let mut out = bytes.to_vec();
+    let name = out
+        .windows(5)
+        .position(|w| w == b"UNITS")
+        .expect("POINT:UNITS record");
+    // name, offset word, type, dimension count, one dimension, then the characters.
+    let data = name + 5 + 2 + 1 + 1 + 1;
+    assert_eq!(&out[data..data + 2], b"mm");
+    out[data..data + 2].copy_from_slice(units);
+    out
+}
+
+#[test]
+fn metres_and_centimetres_are_converted_to_millimetres() {
+    let take = synthetic(3, 10, 1, 100.0);
+    let bytes = write_bytes(&take);
+    for (units, factor, expected) in [
+        (b"cm", 10.0, replay::Units::Centimetres),
+        (b"m ", 1000.0, replay::Units::Metres),
+    ] {
+        let back = c3d::read(&with_units(&bytes, units)[..]).expect("reads");
+        assert_eq!(back.source_units, expected);
+        assert_eq!(back.missing, take.missing);
+        for (a, b) in take.positions.iter().zip(&back.positions) {
+            assert!(
+                (a * factor - b).abs() <= 1e-3 * b.abs().max(1.0),
+                "{a} x {factor} vs {b}"
+            );
+        }
+    }
+    let err = c3d::read(&with_units(&bytes, b"ft")[..]).expect_err("feet are not supported");
+    assert_eq!(
+        err.to_string(),
+        "unknown units \"ft\" (expected mm, cm or m)"
+    );
+}
