@@ -27,6 +27,28 @@ pub enum Command {
     #[command(after_help = "Examples:\n  emoshift convert Facial-Sing.c3d x.trc\n  \
         emoshift convert x.trc y.c3d")]
     Convert(ConvertArgs),
+    /// Learn an ICA model from takes.
+    #[command(
+        after_help = "Examples:\n  emoshift train --manifest session/session.toml --out model.json\n  \
+        emoshift train take1.c3d take2.c3d --out model.json --components 10 --restarts 8"
+    )]
+    Train(TrainArgs),
+    /// Project a take onto a model's components (CSV: frame,time,c0,...).
+    #[command(
+        after_help = "Example:\n  emoshift project --model model.json take.c3d --out components.csv"
+    )]
+    Project(ProjectArgs),
+    /// Edit a take in component space and write it in any format.
+    #[command(
+        after_help = "Examples:\n  emoshift edit --model model.json take.c3d --out edited.c3d --translate 2=1.5\n  \
+        emoshift edit --model model.json take.trc --out louder.trc --gain 0=1.3"
+    )]
+    Edit(EditArgs),
+    /// Show what a model holds.
+    #[command(
+        after_help = "Examples:\n  emoshift inspect model.json\n  emoshift inspect model.json --json"
+    )]
+    Inspect(InspectArgs),
 }
 
 /// `emoshift synth`.
@@ -76,4 +98,107 @@ pub struct ConvertArgs {
     pub input: PathBuf,
     /// Output take; its extension picks the format.
     pub output: PathBuf,
+}
+
+/// `emoshift train`.
+#[derive(Debug, Args)]
+pub struct TrainArgs {
+    /// Session manifest listing the takes (session.toml).
+    #[arg(long)]
+    pub manifest: Option<PathBuf>,
+    /// Take files (in addition to the manifest's).
+    pub files: Vec<PathBuf>,
+    /// Where to write the model (JSON).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Share of the variance the principal components keep, 0.90 to 0.999 (default 0.97).
+    #[arg(long)]
+    pub variance: Option<f64>,
+    /// Keep exactly this many components instead of a variance share.
+    #[arg(long)]
+    pub components: Option<usize>,
+    /// Seed of the FastICA initialisations.
+    #[arg(long, default_value_t = ica_core::fit::DEFAULT_SEED)]
+    pub seed: u64,
+    /// FastICA restarts; the one with the largest negentropy is kept.
+    #[arg(long, default_value_t = ica_core::fit::DEFAULT_RESTARTS)]
+    pub restarts: usize,
+    /// Iteration cap per restart.
+    #[arg(long, default_value_t = ica_core::fit::DEFAULT_MAX_ITER)]
+    pub max_iter: usize,
+    /// Convergence tolerance.
+    #[arg(long, default_value_t = ica_core::fit::DEFAULT_TOL)]
+    pub tol: f64,
+}
+
+/// `emoshift project`.
+#[derive(Debug, Args)]
+pub struct ProjectArgs {
+    /// The model (JSON).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// The take to project.
+    pub file: PathBuf,
+    /// Output CSV: `frame,time,c0,...,c{m-1}`.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `emoshift edit`.
+#[derive(Debug, Args)]
+pub struct EditArgs {
+    /// The model (JSON).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// The take to edit.
+    pub file: PathBuf,
+    /// Output take; its extension picks the format.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Translate component k by alpha: `--translate 2=0.5` (repeatable).
+    #[arg(long, value_parser = parse_key_value)]
+    pub translate: Vec<KeyValue>,
+    /// Multiply component k by g: `--gain 0=1.2` (repeatable).
+    #[arg(long, value_parser = parse_key_value)]
+    pub gain: Vec<KeyValue>,
+    /// Keep the take's gaps in the output instead of filling them from the model.
+    #[arg(long)]
+    pub keep_gaps: bool,
+}
+
+/// `emoshift inspect`.
+#[derive(Debug, Args)]
+pub struct InspectArgs {
+    /// The model (JSON).
+    pub model: PathBuf,
+    /// Print the whole model as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A `k=value` pair of `--translate` and `--gain`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KeyValue {
+    /// Component index.
+    pub key: usize,
+    /// Value.
+    pub value: f64,
+}
+
+fn parse_key_value(text: &str) -> Result<KeyValue, String> {
+    let (k, v) = text
+        .split_once('=')
+        .ok_or_else(|| format!("expected k=value, got {text:?}"))?;
+    let key = k
+        .trim()
+        .parse()
+        .map_err(|_| format!("component index {k:?} is not a whole number"))?;
+    let value: f64 = v
+        .trim()
+        .parse()
+        .map_err(|_| format!("value {v:?} is not a number"))?;
+    if !value.is_finite() {
+        return Err(format!("value {v:?} is not finite"));
+    }
+    Ok(KeyValue { key, value })
 }

@@ -8,4 +8,17 @@
 pub mod cli;
 pub mod commands;
 pub mod exit;
+pub mod layout;
 pub mod logging;
+pub mod offline;
+
+/// `println!` that returns the I/O error instead of panicking, so `emoshift info x | head` ends
+/// quietly when the reader goes away (see [`exit::code_for`], which treats a broken pipe as
+/// success). Use inside functions returning `anyhow::Result`.
+#[macro_export]
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*)?;
+    }};
+}

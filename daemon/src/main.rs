@@ -10,6 +10,7 @@ fn main() -> ExitCode {
     daemon::logging::install();
     match daemon::commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(err) if daemon::exit::is_broken_pipe(&err) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("emoshift: error: {err:#}");
             ExitCode::from(daemon::exit::code_for(&err))

@@ -44,7 +44,7 @@ pub enum TakeError {
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
     /// The underlying reader failed.
-    #[error("cannot read: {0}")]
+    #[error("cannot read")]
     Io(#[from] std::io::Error),
     /// The file extension names no supported format.
     #[error("unknown take format {0:?} (expected .c3d, .trc or .csv)")]
@@ -171,7 +171,7 @@ pub enum ReadError {
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {
     /// The underlying writer failed.
-    #[error("cannot write: {0}")]
+    #[error("cannot write")]
     Io(#[from] std::io::Error),
     /// The file extension names no supported format.
     #[error("unknown take format {0:?} (expected .c3d, .trc or .csv)")]

@@ -8,7 +8,7 @@ pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
     let take = super::load_take(&args.input)?;
     replay::save(&args.output, &take).with_context(|| format!("{}", args.output.display()))?;
     let gaps: usize = take.missing.iter().filter(|&&m| m).count();
-    println!(
+    crate::out!(
         "wrote {}: {} markers, {} frames at {} Hz, {} missing samples",
         args.output.display(),
         take.n_markers(),

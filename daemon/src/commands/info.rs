@@ -47,29 +47,32 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
             .collect(),
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        crate::out!("{}", serde_json::to_string_pretty(&info)?);
     } else {
-        print_text(&info);
+        print_text(&info)?;
     }
     Ok(())
 }
 
-fn print_text(info: &Info<'_>) {
-    println!("file:     {}", info.file);
-    println!("markers:  {}", info.markers);
-    println!(
+fn print_text(info: &Info<'_>) -> Result<()> {
+    crate::out!("file:     {}", info.file);
+    crate::out!("markers:  {}", info.markers);
+    crate::out!(
         "frames:   {} ({}..={}), {:.3} s",
-        info.frames, info.first_frame, info.last_frame, info.duration_s
+        info.frames,
+        info.first_frame,
+        info.last_frame,
+        info.duration_s
     );
-    println!("rate:     {} Hz", info.rate_hz);
-    println!("units:    {} (values shown in mm)", info.source_units);
+    crate::out!("rate:     {} Hz", info.rate_hz);
+    crate::out!("units:    {} (values shown in mm)", info.source_units);
     let total = info.frames * info.markers;
     let pct = if total == 0 {
         0.0
     } else {
         100.0 * info.missing_samples as f64 / total as f64
     };
-    println!("missing:  {} samples ({pct:.2} %)", info.missing_samples);
+    crate::out!("missing:  {} samples ({pct:.2} %)", info.missing_samples);
     let width = info
         .marker_list
         .iter()
@@ -77,8 +80,9 @@ fn print_text(info: &Info<'_>) {
         .max()
         .unwrap_or(5)
         .max(5);
-    println!("  {:<width$}  missing", "label");
+    crate::out!("  {:<width$}  missing", "label");
     for m in &info.marker_list {
-        println!("  {:<width$}  {}", m.label, m.missing);
+        crate::out!("  {:<width$}  {}", m.label, m.missing);
     }
+    Ok(())
 }

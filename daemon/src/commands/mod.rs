@@ -1,8 +1,12 @@
 //! One module per subcommand; [`run`] dispatches.
 
 mod convert;
+mod edit;
 mod info;
+mod inspect;
+mod project;
 mod synth;
+mod train;
 
 use anyhow::Result;
 
@@ -17,11 +21,22 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Synth(args) => synth::run(&args),
         Command::Info(args) => info::run(&args),
         Command::Convert(args) => convert::run(&args),
+        Command::Train(args) => train::run(&args),
+        Command::Project(args) => project::run(&args),
+        Command::Edit(args) => edit::run(&args),
+        Command::Inspect(args) => inspect::run(&args),
     }
 }
 
 /// Loads a take, naming the file in the error.
 pub(crate) fn load_take(path: &std::path::Path) -> Result<replay::Take> {
+    crate::offline::load_take(path)
+}
+
+/// Loads and validates a model file, naming the file in the error.
+pub(crate) fn load_model(path: &std::path::Path) -> Result<ica_core::model::IcaModel> {
     use anyhow::Context;
-    replay::load(path).with_context(|| format!("{}", path.display()))
+    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    ica_core::model::IcaModel::load(std::io::BufReader::new(file))
+        .with_context(|| format!("{}: not a valid model", path.display()))
 }

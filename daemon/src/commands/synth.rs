@@ -23,7 +23,7 @@ pub(crate) fn run(args: &SynthArgs) -> Result<()> {
     params.validate().map_err(|e| UsageError(e.to_string()))?;
     let summary = write_session(&args.out, &params, format)
         .with_context(|| format!("cannot write the session to {}", args.out.display()))?;
-    println!(
+    crate::out!(
         "wrote {} takes ({} frames, {} markers at {} Hz) to {}",
         summary.takes.len(),
         summary.total_frames,
@@ -31,6 +31,6 @@ pub(crate) fn run(args: &SynthArgs) -> Result<()> {
         args.rate,
         summary.dir.display()
     );
-    println!("manifest: {}", summary.manifest.display());
+    crate::out!("manifest: {}", summary.manifest.display());
     Ok(())
 }

@@ -1,0 +1,116 @@
+//! Matching a take's (or a live source's) markers to a model's, by label.
+//!
+//! - a marker the model has but the take lacks becomes a missing sample;
+//! - extra markers of the take are ignored by the model (and passed through by `edit`);
+//! - reordered markers are matched by label;
+//! - a take with none of the model's markers is an error.
+
+/// Why a take cannot be matched to a model.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum LayoutError {
+    /// Not one label in common.
+    #[error("none of the model's {model} markers appear among the take's {take} markers")]
+    NoCommonMarkers {
+        /// Markers in the model.
+        model: usize,
+        /// Markers in the take.
+        take: usize,
+    },
+}
+
+/// For each model marker, the take marker with the same label, if any.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LabelMap {
+    /// `model_to_take[i]`: take index of model marker `i`.
+    pub model_to_take: Vec<Option<usize>>,
+    /// Take markers the model does not know, in take order.
+    pub extra: Vec<usize>,
+}
+
+impl LabelMap {
+    /// Matches labels.
+    ///
+    /// # Errors
+    /// [`LayoutError::NoCommonMarkers`] when no label is shared.
+    pub fn new(model: &[String], take: &[String]) -> Result<LabelMap, LayoutError> {
+        let model_to_take: Vec<Option<usize>> = model
+            .iter()
+            .map(|label| take.iter().position(|t| t == label))
+            .collect();
+        if model_to_take.iter().all(Option::is_none) {
+            return Err(LayoutError::NoCommonMarkers {
+                model: model.len(),
+                take: take.len(),
+            });
+        }
+        let extra = (0..take.len())
+            .filter(|t| !model_to_take.contains(&Some(*t)))
+            .collect();
+        Ok(LabelMap {
+            model_to_take,
+            extra,
+        })
+    }
+
+    /// Model markers the take does not have.
+    pub fn absent(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.model_to_take.len()).filter(|&i| self.model_to_take[i].is_none())
+    }
+
+    /// Copies one take frame into model order. Allocation-free.
+    ///
+    /// # Panics
+    /// If a buffer is shorter than the marker counts it was built for.
+    pub fn gather_into(
+        &self,
+        take_xyz: &[f32],
+        take_missing: &[bool],
+        xyz: &mut [f32],
+        missing: &mut [bool],
+    ) {
+        for (i, src) in self.model_to_take.iter().enumerate() {
+            match *src {
+                Some(t) if !take_missing[t] => {
+                    xyz[i * 3..i * 3 + 3].copy_from_slice(&take_xyz[t * 3..t * 3 + 3]);
+                    missing[i] = false;
+                }
+                _ => {
+                    xyz[i * 3..i * 3 + 3].fill(0.0);
+                    missing[i] = true;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn labels(names: &[&str]) -> Vec<String> {
+        names.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn matches_by_label_with_reorder_absent_and_extra() {
+        let map = LabelMap::new(&labels(&["a", "b", "c"]), &labels(&["c", "x", "a"]))
+            .expect("shared labels");
+        assert_eq!(map.model_to_take, vec![Some(2), None, Some(0)]);
+        assert_eq!(map.extra, vec![1]);
+        assert_eq!(map.absent().collect::<Vec<_>>(), vec![1]);
+        let take = [1.0, 1.0, 1.0, 9.0, 9.0, 9.0, 3.0, 3.0, 3.0];
+        let mut xyz = [0.0; 9];
+        let mut missing = [false; 3];
+        map.gather_into(&take, &[false, false, false], &mut xyz, &mut missing);
+        assert_eq!(xyz, [3.0, 3.0, 3.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0]);
+        assert_eq!(missing, [false, true, false]);
+    }
+
+    #[test]
+    fn no_common_marker_is_an_error() {
+        assert_eq!(
+            LabelMap::new(&labels(&["a"]), &labels(&["b", "c"])),
+            Err(LayoutError::NoCommonMarkers { model: 1, take: 2 })
+        );
+    }
+}

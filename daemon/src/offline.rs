@@ -1,0 +1,188 @@
+//! Offline glue between takes and models: loading the inputs of a command, putting takes in a
+//! model's marker order, projecting and resynthesising whole takes.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use ica_core::edit::FrameEdit;
+use ica_core::model::IcaModel;
+use ica_core::project::{FrameStatus, Projector};
+use replay::session::Session;
+use replay::Take;
+
+use crate::layout::LabelMap;
+
+/// A take loaded from disk, with where it came from.
+#[derive(Debug, Clone)]
+pub struct LoadedTake {
+    /// The file.
+    pub path: PathBuf,
+    /// The take.
+    pub take: Take,
+}
+
+/// Loads a take, naming the file in the error; rejects an empty take.
+///
+/// # Errors
+/// Unreadable, malformed or empty file.
+pub fn load_take(path: &Path) -> Result<Take> {
+    let take = replay::load(path).with_context(|| format!("{}", path.display()))?;
+    if take.n_frames() == 0 {
+        bail!("{}: take has no frames", path.display());
+    }
+    Ok(take)
+}
+
+/// Loads a session manifest, naming the file in the error.
+///
+/// # Errors
+/// Unreadable or invalid manifest.
+pub fn load_session(path: &Path) -> Result<Session> {
+    Session::load(path).with_context(|| format!("{}", path.display()))
+}
+
+/// The input takes of a command: the manifest's takes, or the files given.
+///
+/// # Errors
+/// No input, or any take that cannot be loaded.
+pub fn load_inputs(manifest: Option<&Path>, files: &[PathBuf]) -> Result<Vec<LoadedTake>> {
+    let mut paths: Vec<PathBuf> = files.to_vec();
+    if let Some(manifest) = manifest {
+        paths.extend(load_session(manifest)?.take_paths());
+    }
+    if paths.is_empty() {
+        bail!("no takes given: pass --manifest session.toml or take files");
+    }
+    paths
+        .into_iter()
+        .map(|path| {
+            let take = load_take(&path)?;
+            Ok(LoadedTake { path, take })
+        })
+        .collect()
+}
+
+/// A take in a model's marker order: frames x model markers x 3, and the missing mask.
+#[derive(Debug, Clone)]
+pub struct ModelFrames {
+    /// Positions in model order (mm).
+    pub xyz: Vec<f32>,
+    /// Missing flags in model order.
+    pub missing: Vec<bool>,
+    /// Markers per frame (the model's).
+    pub markers: usize,
+}
+
+impl ModelFrames {
+    /// Frames held.
+    pub fn frames(&self) -> usize {
+        self.missing.len() / self.markers.max(1)
+    }
+
+    /// One frame's positions and mask.
+    pub fn frame(&self, f: usize) -> (&[f32], &[bool]) {
+        let n = self.markers;
+        (
+            &self.xyz[f * n * 3..(f + 1) * n * 3],
+            &self.missing[f * n..(f + 1) * n],
+        )
+    }
+}
+
+/// Gathers a whole take into model order.
+pub fn to_model_order(take: &Take, map: &LabelMap) -> ModelFrames {
+    let markers = map.model_to_take.len();
+    let frames = take.n_frames();
+    let mut xyz = vec![0.0; frames * markers * 3];
+    let mut missing = vec![true; frames * markers];
+    for f in 0..frames {
+        map.gather_into(
+            take.frame(f),
+            take.frame_missing(f),
+            &mut xyz[f * markers * 3..(f + 1) * markers * 3],
+            &mut missing[f * markers..(f + 1) * markers],
+        );
+    }
+    ModelFrames {
+        xyz,
+        missing,
+        markers,
+    }
+}
+
+/// Matches a take to a model by label.
+///
+/// # Errors
+/// No shared marker, naming the file.
+pub fn match_take(model: &IcaModel, take: &Take, path: &Path) -> Result<LabelMap> {
+    LabelMap::new(model.labels(), &take.labels).with_context(|| format!("{}", path.display()))
+}
+
+/// Component series of a take: frames x m (`f32`), with each frame's projection status.
+#[derive(Debug, Clone)]
+pub struct Projected {
+    /// Components, frames x m.
+    pub u: Vec<f32>,
+    /// Per-frame status (masked, held...).
+    pub status: Vec<FrameStatus>,
+    /// Components per frame.
+    pub m: usize,
+}
+
+impl Projected {
+    /// Component `k` over the take, as `f64`.
+    pub fn component(&self, k: usize) -> Vec<f64> {
+        self.u
+            .chunks_exact(self.m)
+            .map(|row| f64::from(row[k]))
+            .collect()
+    }
+
+    /// The whole series as `f64`, frames x m.
+    pub fn as_f64(&self) -> Vec<f64> {
+        self.u.iter().map(|&v| f64::from(v)).collect()
+    }
+}
+
+/// Projects every frame of a take (masked where markers are missing).
+///
+/// # Errors
+/// A frame buffer that does not match the model (an internal invariant).
+pub fn project_take(model: &IcaModel, frames: &ModelFrames) -> Result<Projected> {
+    let mut projector = Projector::new(model);
+    let m = model.components();
+    let n = frames.frames();
+    let mut u = vec![0.0f32; n * m];
+    let mut status = Vec::with_capacity(n);
+    for f in 0..n {
+        let (xyz, missing) = frames.frame(f);
+        let st = projector.project_masked_into(xyz, Some(missing), &mut u[f * m..(f + 1) * m])?;
+        status.push(st);
+    }
+    Ok(Projected { u, status, m })
+}
+
+/// Resynthesises a take from (edited) components, one [`FrameEdit`] per frame produced by `edit`.
+///
+/// # Errors
+/// A buffer that does not match the model (an internal invariant).
+pub fn resynthesise(
+    model: &IcaModel,
+    projected: &Projected,
+    mut edit: impl FnMut(usize, &mut FrameEdit),
+) -> Result<Vec<f32>> {
+    let projector = Projector::new(model);
+    let m = projected.m;
+    let channels = model.channels();
+    let frames = projected.u.len() / m.max(1);
+    let mut out = vec![0.0f32; frames * channels];
+    let mut frame_edit = FrameEdit::identity(m);
+    let mut u = vec![0.0f32; m];
+    for f in 0..frames {
+        edit(f, &mut frame_edit);
+        u.copy_from_slice(&projected.u[f * m..(f + 1) * m]);
+        frame_edit.apply(&mut u)?;
+        projector.resynth_into(&u, &mut out[f * channels..(f + 1) * channels])?;
+    }
+    Ok(out)
+}
