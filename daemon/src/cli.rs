@@ -49,6 +49,11 @@ pub enum Command {
         after_help = "Examples:\n  emoshift inspect model.json\n  emoshift inspect model.json --json"
     )]
     Inspect(InspectArgs),
+    /// Label the components (emotion, speech, eyebrows, eyelids) and write the report.
+    #[command(
+        after_help = "Example:\n  emoshift analyze --model model.json --manifest session/session.toml --out report --write-model"
+    )]
+    Analyze(AnalyzeArgs),
 }
 
 /// `emoshift synth`.
@@ -201,4 +206,24 @@ fn parse_key_value(text: &str) -> Result<KeyValue, String> {
         return Err(format!("value {v:?} is not finite"));
     }
     Ok(KeyValue { key, value })
+}
+
+/// `emoshift analyze`.
+#[derive(Debug, Args)]
+pub struct AnalyzeArgs {
+    /// The model (JSON).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Session manifest (session.toml) with sentence and emotion per take.
+    #[arg(long)]
+    pub manifest: PathBuf,
+    /// Regions file (default: regions.toml beside the manifest).
+    #[arg(long)]
+    pub regions: Option<PathBuf>,
+    /// Output folder for report.json, components.svg, timeline.svg and report.html.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Store the roles and emotion levels in the model file.
+    #[arg(long)]
+    pub write_model: bool,
 }

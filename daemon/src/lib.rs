@@ -5,6 +5,7 @@
 //! [`commands`] over the library crates (`replay`, `ica-core`, `protocol`).
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod cli;
 pub mod commands;
 pub mod exit;

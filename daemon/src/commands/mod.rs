@@ -1,5 +1,6 @@
 //! One module per subcommand; [`run`] dispatches.
 
+mod analyze;
 mod convert;
 mod edit;
 mod info;
@@ -25,6 +26,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Project(args) => project::run(&args),
         Command::Edit(args) => edit::run(&args),
         Command::Inspect(args) => inspect::run(&args),
+        Command::Analyze(args) => analyze::run(&args),
     }
 }
 

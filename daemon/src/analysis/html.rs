@@ -1,0 +1,77 @@
+//! `report.html`: both figures with short explanations and the metrics table.
+
+use std::fmt::Write as _;
+
+use super::svg::role_colour;
+use super::Report;
+
+/// The report page; it references `components.svg` and `timeline.svg` beside it.
+pub fn page(report: &Report) -> String {
+    let mut rows = String::new();
+    let regions: Vec<&String> = report
+        .components
+        .first()
+        .map(|c| c.d_region.keys().collect())
+        .unwrap_or_default();
+    for c in &report.components {
+        let _ = write!(
+            rows,
+            r#"<tr><td>c{}</td><td style="color:{}"><b>{:?}</b></td><td>{}</td>"#,
+            c.index,
+            role_colour(c.role),
+            c.role,
+            c.d_emotion.map_or("—".into(), |d| format!("{d:.4}"))
+        );
+        for r in &regions {
+            let _ = write!(rows, "<td>{:.4}</td>", c.d_region[*r]);
+        }
+        let _ = write!(rows, "<td>{:.2}</td></tr>", c.mixing_norm_mm);
+    }
+    let header: String = regions.iter().map(|r| format!("<th>d_{r}</th>")).collect();
+    let levels: String = report
+        .levels
+        .iter()
+        .map(|(n, v)| format!("<li>{n}: {v:.4}</li>"))
+        .collect();
+    let t = &report.thresholds;
+    let note = if report.emotion_note.is_empty() {
+        format!("Emotion component(s): {:?}.", report.emotion_components)
+    } else {
+        report.emotion_note.clone()
+    };
+    format!(
+        r#"<!doctype html>
+<html><head><meta charset="utf-8"><title>emoshift analysis</title>
+<style>body{{font-family:sans-serif;max-width:1050px;margin:2em auto}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:2px 6px;text-align:right}}</style>
+</head><body>
+<h1>emoshift analysis</h1>
+<p>Model <code>{model}</code>, session <code>{manifest}</code>: {m} components, {pairs} emotion pairs.</p>
+<h2>Which component does what</h2>
+<p>(a) <b>d_emotion</b>: for takes of the same sentence in two emotions, aligned by dynamic time
+warping, the RMS difference of each component. A clear peak marks the emotion component.
+(b–d) <b>region metrics</b>: how much adding one component moves the mouth, eyebrow and eyelid
+markers towards the full reconstruction (|d_region,i|, Eq. 4 of the method).
+Bars are coloured by the role given.</p>
+<img src="components.svg" alt="bar charts of d_emotion, d_mouth, d_eyebrows and d_eyelids per component">
+<p>{note}</p>
+<h2>Components over time</h2>
+<p>Each row is one component over takes that alternate between the two most different emotions
+(shaded backgrounds). The emotion component jumps between levels when the emotion changes; speech
+components follow the words.</p>
+<img src="timeline.svg" alt="component series over alternating-emotion takes">
+<h2>Levels</h2><ul>{levels}</ul>
+<h2>Metrics</h2>
+<table><tr><th>component</th><th>role</th><th>d_emotion</th>{header}<th>|M_k| mm</th></tr>{rows}</table>
+<p>Thresholds: emotion when d_emotion ≥ {r1} × median and ≥ {r2} × max; a region's role when
+|d_region| ≥ {r3} × the region's largest (the largest relative share wins).</p>
+</body></html>
+"#,
+        model = report.model,
+        manifest = report.manifest,
+        m = report.components.len(),
+        pairs = report.pairs.len(),
+        r1 = t.emotion_peak_ratio,
+        r2 = t.emotion_share_of_max,
+        r3 = t.region_share_of_max,
+    )
+}

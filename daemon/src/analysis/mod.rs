@@ -1,0 +1,366 @@
+//! `emoshift analyze`: give the components their meaning (section 4 of the method).
+//!
+//! Every take of the manifest is projected onto the model. Pairs of takes with the same
+//! sentence and different emotions give `d_emotion` (DTW-aligned RMS difference per component);
+//! its clear peak is the emotion component. Region metrics `d_region,i` on the mouth, eyebrows and
+//! eyelids label the speech, eyebrow and eyelid components (thresholds in
+//! [`ica_core::interpret::LabelRules`]). Each named emotion gets a level: the mean of the emotion
+//! component over that emotion's takes.
+
+mod html;
+mod svg;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use ica_core::interpret::{self, LabelRules};
+use ica_core::model::{IcaModel, Role};
+use replay::session::{Regions, Session};
+use serde::Serialize;
+
+use crate::offline::{self, Projected};
+
+/// Region names whose metrics decide roles, with the role they give.
+pub const ROLE_REGIONS: [(&str, Role); 3] = [
+    ("mouth", Role::Speech),
+    ("eyebrows", Role::Eyebrows),
+    ("eyelids", Role::Eyelids),
+];
+
+/// DTW band as a share of the longer take of a pair: the generator's warps stay within ±20 %.
+pub const DTW_BAND_SHARE: f64 = 0.25;
+
+/// One analysed take.
+#[derive(Debug, Clone, Serialize)]
+pub struct TakeSummary {
+    /// File, as the manifest names it.
+    pub file: String,
+    /// Sentence id.
+    pub sentence: String,
+    /// Emotion name.
+    pub emotion: String,
+    /// Frames.
+    pub frames: usize,
+    /// Mean of each component over the take.
+    pub component_means: Vec<f64>,
+}
+
+/// One pair used for `d_emotion`.
+#[derive(Debug, Clone, Serialize)]
+pub struct PairSummary {
+    /// Sentence id.
+    pub sentence: String,
+    /// First take's file and emotion.
+    pub a: (String, String),
+    /// Second take's file and emotion.
+    pub b: (String, String),
+    /// Aligned samples.
+    pub aligned_samples: usize,
+}
+
+/// Metrics and role of one component.
+#[derive(Debug, Clone, Serialize)]
+pub struct ComponentReport {
+    /// Component index.
+    pub index: usize,
+    /// `emotion`, `speech`, `eyebrows`, `eyelids` or `other`.
+    pub role: Role,
+    /// `d_emotion` (absent without pairs).
+    pub d_emotion: Option<f64>,
+    /// `d_region` for every region of the regions file.
+    pub d_region: BTreeMap<String, f64>,
+    /// Marker-space displacement of one unit of the component (mm, mixing column norm).
+    pub mixing_norm_mm: f64,
+}
+
+/// The whole analysis, written as `report.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Model file analysed.
+    pub model: String,
+    /// Manifest used.
+    pub manifest: String,
+    /// Components with metrics and roles.
+    pub components: Vec<ComponentReport>,
+    /// The emotion component(s).
+    pub emotion_components: Vec<usize>,
+    /// Whether `d_emotion` could be measured, and if not why.
+    pub emotion_measured: bool,
+    /// Why emotion was not measured or no clear peak was found (empty when it was).
+    pub emotion_note: String,
+    /// Level of the emotion component per emotion name.
+    pub levels: BTreeMap<String, f64>,
+    /// Pairs used for `d_emotion`.
+    pub pairs: Vec<PairSummary>,
+    /// Takes analysed.
+    pub takes: Vec<TakeSummary>,
+    /// Thresholds of the labelling rule.
+    pub thresholds: LabelRules,
+    /// DTW band as a share of the longer take of each pair.
+    pub dtw_band_share: f64,
+    /// Marker indices of each region.
+    pub regions: BTreeMap<String, Vec<String>>,
+}
+
+/// Inputs of an analysis.
+#[derive(Debug)]
+pub struct Inputs<'a> {
+    /// The model.
+    pub model: &'a IcaModel,
+    /// Its file (for the report).
+    pub model_path: &'a Path,
+    /// The manifest file.
+    pub manifest_path: &'a Path,
+    /// The regions file.
+    pub regions_path: &'a Path,
+}
+
+/// A projected take of the session.
+#[derive(Debug)]
+pub struct SessionTake {
+    /// Manifest entry.
+    pub file: String,
+    /// Sentence id.
+    pub sentence: String,
+    /// Emotion name.
+    pub emotion: String,
+    /// Components over the take.
+    pub projected: Projected,
+}
+
+/// Loads and projects every take of a manifest.
+///
+/// # Errors
+/// Unreadable takes, or a take sharing no marker with the model.
+pub fn project_session(model: &IcaModel, session: &Session) -> Result<Vec<SessionTake>> {
+    session
+        .takes
+        .iter()
+        .map(|entry| {
+            let path = session.path_of(entry);
+            let take = offline::load_take(&path)?;
+            let map = offline::match_take(model, &take, &path)?;
+            let projected = offline::project_take(model, &offline::to_model_order(&take, &map))?;
+            Ok(SessionTake {
+                file: entry.file.clone(),
+                sentence: entry.sentence.clone(),
+                emotion: entry.emotion.clone(),
+                projected,
+            })
+        })
+        .collect()
+}
+
+/// Resolves the regions file against the model's labels; the role regions must be present.
+///
+/// # Errors
+/// Unreadable file, a region naming no marker, or a missing mouth/eyebrows/eyelids region.
+pub fn resolve_regions(path: &Path, model: &IcaModel) -> Result<BTreeMap<String, Vec<usize>>> {
+    let regions = Regions::load(path).with_context(|| format!("{}", path.display()))?;
+    let resolved = regions
+        .resolve(model.labels())
+        .with_context(|| format!("{}", path.display()))?;
+    for (name, _) in ROLE_REGIONS {
+        if !resolved.contains_key(name) {
+            bail!(
+                "{}: no {name:?} region; analyze needs mouth, eyebrows and eyelids",
+                path.display()
+            );
+        }
+    }
+    Ok(resolved)
+}
+
+fn pairs_of(takes: &[SessionTake]) -> Vec<(usize, usize)> {
+    let mut pairs = Vec::new();
+    for (i, a) in takes.iter().enumerate() {
+        for (j, b) in takes.iter().enumerate().skip(i + 1) {
+            if a.sentence == b.sentence && a.emotion != b.emotion {
+                pairs.push((i, j));
+            }
+        }
+    }
+    pairs
+}
+
+/// Runs the analysis on projected takes.
+///
+/// # Errors
+/// A metric that cannot be computed (bad shapes, non-finite components).
+pub fn analyze(
+    inputs: &Inputs<'_>,
+    takes: &[SessionTake],
+    regions: &BTreeMap<String, Vec<usize>>,
+) -> Result<Report> {
+    let model = inputs.model;
+    let m = model.components();
+    let rules = LabelRules::default();
+    let series: Vec<Vec<f64>> = takes.iter().map(|t| t.projected.as_f64()).collect();
+    let pairs = pairs_of(takes);
+    let (d_emotion, pair_summaries) = if pairs.is_empty() {
+        (None, Vec::new())
+    } else {
+        let refs: Vec<(&[f64], &[f64])> = pairs
+            .iter()
+            .map(|&(i, j)| (series[i].as_slice(), series[j].as_slice()))
+            .collect();
+        let longest = series.iter().map(|s| s.len() / m).max().unwrap_or(0);
+        let band = ((longest as f64) * DTW_BAND_SHARE).ceil() as usize;
+        let d = interpret::emotion_distance(&refs, m, Some(band))?;
+        let summaries = pairs
+            .iter()
+            .zip(&d.aligned_samples)
+            .map(|(&(i, j), &q)| PairSummary {
+                sentence: takes[i].sentence.clone(),
+                a: (takes[i].file.clone(), takes[i].emotion.clone()),
+                b: (takes[j].file.clone(), takes[j].emotion.clone()),
+                aligned_samples: q,
+            })
+            .collect();
+        (Some(d.per_component), summaries)
+    };
+    let emotion = d_emotion
+        .as_deref()
+        .map(|d| interpret::emotion_components(d, &rules))
+        .unwrap_or_default();
+    let all: Vec<&[f64]> = series.iter().map(Vec::as_slice).collect();
+    let mut d_region = BTreeMap::new();
+    for (name, markers) in regions {
+        let d = interpret::region_distance(model.mixing(), &all, markers, &emotion)?;
+        d_region.insert(name.clone(), d);
+    }
+    let role_inputs: Vec<(Role, &[f64])> = ROLE_REGIONS
+        .iter()
+        .filter_map(|(name, role)| d_region.get(*name).map(|d| (*role, d.as_slice())))
+        .collect();
+    let roles = interpret::label(m, &emotion, &role_inputs, &rules);
+    let levels = emotion_levels(
+        takes,
+        &series,
+        m,
+        main_emotion(&emotion, d_emotion.as_deref()),
+    );
+    let emotion_note = match (&d_emotion, emotion.is_empty()) {
+        (None, _) => "emotion not measured: the manifest has no pair of takes with the same \
+                      sentence in two different emotions"
+            .to_string(),
+        (Some(_), true) => "no clear peak in d_emotion: no component is labelled emotion".into(),
+        (Some(_), false) => String::new(),
+    };
+    let components = (0..m)
+        .map(|k| ComponentReport {
+            index: k,
+            role: roles[k],
+            d_emotion: d_emotion.as_ref().map(|d| d[k]),
+            d_region: d_region.iter().map(|(n, d)| (n.clone(), d[k])).collect(),
+            mixing_norm_mm: model.mixing().column(k).norm(),
+        })
+        .collect();
+    Ok(Report {
+        model: inputs.model_path.display().to_string(),
+        manifest: inputs.manifest_path.display().to_string(),
+        components,
+        emotion_components: emotion,
+        emotion_measured: d_emotion.is_some(),
+        emotion_note,
+        levels,
+        pairs: pair_summaries,
+        takes: takes
+            .iter()
+            .zip(&series)
+            .map(|(t, s)| TakeSummary {
+                file: t.file.clone(),
+                sentence: t.sentence.clone(),
+                emotion: t.emotion.clone(),
+                frames: s.len() / m,
+                component_means: (0..m)
+                    .map(|k| interpret::component_mean(&[s], m, k).unwrap_or(0.0))
+                    .collect(),
+            })
+            .collect(),
+        thresholds: rules,
+        dtw_band_share: DTW_BAND_SHARE,
+        regions: regions
+            .iter()
+            .map(|(n, idx)| {
+                (
+                    n.clone(),
+                    idx.iter().map(|&i| model.labels()[i].clone()).collect(),
+                )
+            })
+            .collect(),
+    })
+}
+
+/// The emotion component the levels are measured on: the largest `d_emotion` among the peaks.
+fn main_emotion(emotion: &[usize], d: Option<&[f64]>) -> Option<usize> {
+    let d = d?;
+    emotion
+        .iter()
+        .copied()
+        .max_by(|&a, &b| d[a].total_cmp(&d[b]))
+}
+
+fn emotion_levels(
+    takes: &[SessionTake],
+    series: &[Vec<f64>],
+    m: usize,
+    k: Option<usize>,
+) -> BTreeMap<String, f64> {
+    let Some(k) = k else { return BTreeMap::new() };
+    let mut by_emotion: BTreeMap<String, Vec<&[f64]>> = BTreeMap::new();
+    for (t, s) in takes.iter().zip(series) {
+        by_emotion.entry(t.emotion.clone()).or_default().push(s);
+    }
+    by_emotion
+        .into_iter()
+        .filter_map(|(name, s)| interpret::component_mean(&s, m, k).map(|v| (name, v)))
+        .collect()
+}
+
+/// Stores roles, the emotion component and its levels in the model.
+///
+/// # Errors
+/// A component index outside the model (an internal invariant).
+pub fn write_into_model(model: &mut IcaModel, report: &Report) -> Result<()> {
+    for c in &report.components {
+        model.set_role(c.index, c.role)?;
+    }
+    let main = main_emotion(
+        &report.emotion_components,
+        report
+            .components
+            .iter()
+            .map(|c| c.d_emotion)
+            .collect::<Option<Vec<f64>>>()
+            .as_deref(),
+    );
+    model.set_emotion_component(main)?;
+    for (name, level) in &report.levels {
+        model.set_emotion_level(name, *level)?;
+    }
+    Ok(())
+}
+
+/// Writes `report.json`, `components.svg`, `timeline.svg` and `report.html` into `dir`.
+///
+/// # Errors
+/// Any file that cannot be written.
+pub fn write_report(dir: &Path, report: &Report, takes: &[SessionTake]) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let write = |name: &str, text: String| -> Result<PathBuf> {
+        let path = dir.join(name);
+        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(path)
+    };
+    let json = serde_json::to_string_pretty(report).context("report serialisation")?;
+    let components = svg::components_chart(report);
+    let timeline = svg::timeline_chart(report, takes);
+    Ok(vec![
+        write("report.json", json)?,
+        write("components.svg", components)?,
+        write("timeline.svg", timeline)?,
+        write("report.html", html::page(report))?,
+    ])
+}
