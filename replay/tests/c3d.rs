@@ -124,6 +124,13 @@ fn facial_sing_reads_with_its_gaps() {
     assert_eq!(take.source_units, replay::Units::Millimetres);
     let missing = take.missing_per_marker();
     assert_eq!(missing.iter().sum::<usize>(), 3716);
+    // Per marker, in file order (root-1..6, section1-1 ... section14-3, Unlabeled1): every
+    // sample flagged by residual -1 has xyz exactly 0 in this file, so both rules agree.
+    let expected = [
+        0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 33, 0, 42, 110, 254, 0, 257, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+        0, 0, 0, 0, 55, 0, 0, 0, 0, 2965,
+    ];
+    assert_eq!(missing, expected);
     let unlabeled = take.marker_index("Unlabeled1").expect("Unlabeled1 marker");
     assert!(missing[unlabeled] > 2500, "Unlabeled1 is mostly missing");
 }
