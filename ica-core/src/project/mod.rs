@@ -28,7 +28,7 @@ pub use masked::MIN_OBSERVABILITY;
 
 use crate::edit::FrameEdit;
 use crate::model::IcaModel;
-use kernels::{all_finite, axpy, axpy4, panel_gemv, sub_into, PANEL_WIDTHS};
+use kernels::{axpy, axpy4, panel_gemv, sub_into, PANEL_WIDTHS};
 use masked::MaskedSolver;
 
 /// A frame buffer of the wrong length. Small and `Copy`: returned per frame.
@@ -154,8 +154,7 @@ impl Projector {
     pub fn project_into(&mut self, x: &[f32], u: &mut [f32]) -> Result<(), FrameError> {
         check_len("frame", self.channels, x.len())?;
         check_len("components", self.components, u.len())?;
-        sub_into(x, &self.mean, &mut self.centered);
-        self.project_centered(u);
+        self.project_full(x, u);
         self.last_u.copy_from_slice(u);
         Ok(())
     }
@@ -177,16 +176,20 @@ impl Projector {
         if let Some(mask) = missing {
             check_len("missing mask", self.markers(), mask.len())?;
         }
-        sub_into(x, &self.mean, &mut self.centered);
         let any_flag = missing.is_some_and(|mask| mask.iter().any(|&b| b));
-        if !any_flag && all_finite(&self.centered) {
-            self.project_centered(u);
+        // A non-finite coordinate makes every u_k non-finite (NaN·w = ±inf·0 = NaN, ±inf·w =
+        // ±inf, and sums keep them), so checking the m outputs replaces a pass over the frame.
+        if !any_flag {
+            self.project_full(x, u);
+        }
+        if !any_flag && u.iter().all(|v| v.is_finite()) {
             self.last_u.copy_from_slice(u);
             return Ok(FrameStatus {
                 observability: 1.0,
                 ..FrameStatus::default()
             });
         }
+        sub_into(x, &self.mean, &mut self.centered);
         Ok(self.project_gappy(missing, u))
     }
 
@@ -261,17 +264,18 @@ impl Projector {
         Ok(status)
     }
 
-    /// `u = W · centered`.
-    fn project_centered(&self, u: &mut [f32]) {
-        let (w, c) = (&self.unmixing, &self.centered);
+    /// `u = W (x − mean)`; the panel kernels fuse the subtraction into the product.
+    fn project_full(&mut self, x: &[f32], u: &mut [f32]) {
+        let (w, mean) = (&self.unmixing, &self.mean);
         match self.panel_width {
-            8 => panel_gemv::<8>(w, c, u),
-            16 => panel_gemv::<16>(w, c, u),
-            24 => panel_gemv::<24>(w, c, u),
-            32 => panel_gemv::<32>(w, c, u),
+            8 => panel_gemv::<8>(w, x, mean, u),
+            16 => panel_gemv::<16>(w, x, mean, u),
+            24 => panel_gemv::<24>(w, x, mean, u),
+            32 => panel_gemv::<32>(w, x, mean, u),
             _ => {
+                sub_into(x, mean, &mut self.centered);
                 for (row, o) in w.chunks_exact(self.channels).zip(u.iter_mut()) {
-                    *o = kernels::dot(row, c);
+                    *o = kernels::dot(row, &self.centered);
                 }
             }
         }
