@@ -12,6 +12,7 @@
 mod error;
 mod file;
 mod json_rows;
+mod take;
 
 pub use error::ModelError;
 pub use file::FORMAT_VERSION;
@@ -216,48 +217,6 @@ impl IcaModel {
     /// Removes a named emotion level, returning its value.
     pub fn remove_emotion_level(&mut self, name: &str) -> Option<f64> {
         self.emotion.levels.remove(name)
-    }
-
-    /// Projects a take, frames x channels, to its components, frames x components:
-    /// `u = W (x - mean)` per frame, in f64.
-    ///
-    /// # Errors
-    /// [`ModelError::ShapeMismatch`] when `frames` does not have `channels` columns.
-    pub fn project(&self, frames: &DMatrix<f64>) -> Result<DMatrix<f64>, ModelError> {
-        let n = self.channels();
-        if frames.ncols() != n {
-            return Err(ModelError::ShapeMismatch {
-                what: "take",
-                expected: (frames.nrows(), n),
-                got: frames.shape(),
-            });
-        }
-        let mut centered = frames.clone();
-        for (j, mut col) in centered.column_iter_mut().enumerate() {
-            col.add_scalar_mut(-self.mean[j]);
-        }
-        Ok(centered * self.unmixing.transpose())
-    }
-
-    /// Resynthesises a take from components, frames x components, to frames x channels:
-    /// `x = mean + M u` per frame, in f64.
-    ///
-    /// # Errors
-    /// [`ModelError::ShapeMismatch`] when `components` does not have `components` columns.
-    pub fn resynthesize(&self, components: &DMatrix<f64>) -> Result<DMatrix<f64>, ModelError> {
-        let m = self.components();
-        if components.ncols() != m {
-            return Err(ModelError::ShapeMismatch {
-                what: "component series",
-                expected: (components.nrows(), m),
-                got: components.shape(),
-            });
-        }
-        let mut out = components * self.mixing.transpose();
-        for (j, mut col) in out.column_iter_mut().enumerate() {
-            col.add_scalar_mut(self.mean[j]);
-        }
-        Ok(out)
     }
 
     fn check_component(&self, what: &'static str, k: usize) -> Result<(), ModelError> {
