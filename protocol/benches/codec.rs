@@ -43,6 +43,23 @@ fn codec(c: &mut Criterion) {
     g.bench_function("rosc_decode", |b| {
         b.iter(|| rosc::decoder::decode_udp(black_box(&bytes)).expect("valid"))
     });
+    // what a rosc user must add to get positions out of the blob
+    g.bench_function("rosc_decode_and_convert", |b| {
+        b.iter(|| {
+            let (_, p) = rosc::decoder::decode_udp(black_box(&bytes)).expect("valid");
+            let rosc::OscPacket::Message(m) = p else {
+                unreachable!("a frame is a message")
+            };
+            let Some(rosc::OscType::Blob(pos)) = m.args.get(3) else {
+                unreachable!("positions are the fourth argument")
+            };
+            let v: Vec<f32> = pos
+                .chunks_exact(4)
+                .map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]]))
+                .collect();
+            v
+        })
+    });
     g.bench_function("decode_flat", |b| {
         b.iter(|| decode_frame_into(black_box(&flat), &mut buf).expect("valid"))
     });

@@ -165,8 +165,17 @@ impl FrameBuf {
         Ok(())
     }
 
-    /// Empties the buffer for `n` markers, all present, without reallocating.
+    /// Empties the buffer for `n` markers, all present at the origin, without reallocating.
     fn reset(&mut self, n: usize, form: FrameForm) -> Result<(), DecodeError> {
+        self.reset_empty(n, form)?;
+        self.positions.resize(n * 3, 0.0);
+        self.missing.resize(n.div_ceil(8), 0);
+        Ok(())
+    }
+
+    /// Checks capacity and sets the header for `n` markers, leaving positions and mask empty
+    /// for the caller to fill with exactly `3 n` and `n.div_ceil(8)` values.
+    fn reset_empty(&mut self, n: usize, form: FrameForm) -> Result<(), DecodeError> {
         if n > self.max_markers {
             return Err(DecodeError::TooManyMarkers {
                 markers: n,
@@ -174,9 +183,7 @@ impl FrameBuf {
             });
         }
         self.positions.clear();
-        self.positions.resize(n * 3, 0.0);
         self.missing.clear();
-        self.missing.resize(n.div_ceil(8), 0);
         self.header.marker_count = n;
         self.header.missing_count = 0;
         self.header.form = form;
@@ -260,24 +267,25 @@ fn decode_blob_form(r: &mut Reader<'_>, buf: &mut FrameBuf) -> Result<(), Decode
             got: mask.len() * 8,
         });
     }
-    buf.reset(n, FrameForm::Blob)?;
+    buf.reset_empty(n, FrameForm::Blob)?;
     buf.set_header(frame_number, capture_time_us);
-    buf.missing.copy_from_slice(mask);
+    buf.missing.extend_from_slice(mask);
+    // convert every coordinate in one tight loop (it vectorises), then fix up and validate
+    buf.positions.extend(
+        coords
+            .chunks_exact(4)
+            .map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]])),
+    );
+    let all_present = mask.iter().all(|&b| b == 0);
+    if all_present && buf.positions.iter().all(|v| v.is_finite()) {
+        return Ok(());
+    }
     let mut missing = 0;
-    for (m, (src, dst)) in coords
-        .chunks_exact(12)
-        .zip(buf.positions.chunks_exact_mut(3))
-        .enumerate()
-    {
+    for (m, xyz) in buf.positions.chunks_exact_mut(3).enumerate() {
         if mask[m / 8] >> (m % 8) & 1 == 1 {
-            dst.fill(f32::NAN);
+            xyz.fill(f32::NAN);
             missing += 1;
-            continue;
-        }
-        for (c, d) in src.chunks_exact(4).zip(dst.iter_mut()) {
-            *d = f32::from_be_bytes([c[0], c[1], c[2], c[3]]);
-        }
-        if !dst.iter().all(|v| v.is_finite()) {
+        } else if !xyz.iter().all(|v| v.is_finite()) {
             return Err(DecodeError::NonFinite { marker: m });
         }
     }
@@ -299,11 +307,29 @@ fn decode_flat_form(
     let frame_number = r.i32()?;
     let capture_time_us = r.i64()?;
     let coords = r.take(floats * 4)?;
-    buf.reset(floats / 3, FrameForm::Flat)?;
+    let n = floats / 3;
+    buf.reset_empty(n, FrameForm::Flat)?;
     buf.set_header(frame_number, capture_time_us);
-    for (m, c) in coords.chunks_exact(12).enumerate() {
-        let f = |k: usize| f32::from_be_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
-        buf.put_flat_marker(m, [f(0), f(4), f(8)])?;
+    buf.missing.resize(n.div_ceil(8), 0);
+    buf.positions.extend(
+        coords
+            .chunks_exact(4)
+            .map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]])),
+    );
+    if buf.positions.iter().all(|v| v.is_finite()) {
+        return Ok(());
+    }
+    for m in 0..n {
+        let xyz = &buf.positions[3 * m..3 * m + 3];
+        match xyz.iter().filter(|v| v.is_nan()).count() {
+            0 if xyz.iter().all(|v| v.is_finite()) => {}
+            0 => return Err(DecodeError::NonFinite { marker: m }),
+            3 => {
+                buf.missing[m / 8] |= 1 << (m % 8);
+                buf.header.missing_count += 1;
+            }
+            _ => return Err(DecodeError::PartlyMissing { marker: m }),
+        }
     }
     Ok(())
 }
@@ -336,6 +362,12 @@ pub(crate) fn append_frame(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<(), En
     out.extend_from_slice(&frame.missing);
     wire::pad_to4(out, start);
     wire::put_blob_len(out, frame.positions.len() * 4);
+    if frame.header.missing_count == 0 && frame.positions.iter().all(|v| v.is_finite()) {
+        for &v in &frame.positions {
+            wire::put_f32(out, v);
+        }
+        return Ok(());
+    }
     for (m, xyz) in frame.positions.chunks_exact(3).enumerate() {
         let missing = frame.is_missing(m);
         if !missing && !xyz.iter().all(|v| v.is_finite()) {
