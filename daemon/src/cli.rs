@@ -166,6 +166,21 @@ pub struct EditArgs {
     /// Multiply component k by g: `--gain 0=1.2` (repeatable).
     #[arg(long, value_parser = parse_key_value)]
     pub gain: Vec<KeyValue>,
+    /// Move the emotion towards a named level (needs an analysed model).
+    #[arg(long, value_name = "NAME")]
+    pub to_emotion: Option<String>,
+    /// How far to move towards --to-emotion: 0 keeps the take, 1 reaches the level.
+    #[arg(long, default_value_t = 1.0)]
+    pub amount: f64,
+    /// Copy & Replace: take the emotion series of another take (DTW-aligned to this one).
+    #[arg(long, value_name = "OTHER")]
+    pub replace_emotion_from: Option<PathBuf>,
+    /// Copy & Add: add the emotion series of another take under --other-model.
+    #[arg(long, value_name = "OTHER", requires = "other_model")]
+    pub add_emotion_from: Option<PathBuf>,
+    /// The second model of Copy & Add.
+    #[arg(long, value_name = "M2")]
+    pub other_model: Option<PathBuf>,
     /// Keep the take's gaps in the output instead of filling them from the model.
     #[arg(long)]
     pub keep_gaps: bool,

@@ -115,6 +115,32 @@ pub fn emotion_distance(
     })
 }
 
+/// `d_level,j`: the RMS over pairs of the difference of component `j`'s take means.
+///
+/// Emotion moves a component's level for a whole take, while speech, blinks and noise average
+/// out over a take of the same sentence. Unlike `d_emotion`, this does not grow with components
+/// that are noise (independent between takes, so their aligned RMS difference is about √2 for a
+/// unit-variance component), which makes its peak the robust label of emotion when the variance
+/// target keeps many components.
+///
+/// # Errors
+/// A series of the wrong shape.
+pub fn level_distance(pairs: &[(&[f64], &[f64])], m: usize) -> Result<Vec<f64>, InterpretError> {
+    let mut sum = vec![0.0; m];
+    for (a, b) in pairs {
+        let (na, nb) = (frames_of(a, m)?, frames_of(b, m)?);
+        for (k, acc) in sum.iter_mut().enumerate() {
+            let ma = a.iter().skip(k).step_by(m).sum::<f64>() / na.max(1) as f64;
+            let mb = b.iter().skip(k).step_by(m).sum::<f64>() / nb.max(1) as f64;
+            *acc += (ma - mb) * (ma - mb);
+        }
+    }
+    Ok(sum
+        .iter()
+        .map(|s| (s / pairs.len().max(1) as f64).sqrt())
+        .collect())
+}
+
 /// `d_region,i` for every component `i` (Eq. 4), given the emotion subset `emotion` (`E`, may be
 /// empty) and the region's marker indices.
 ///
@@ -185,27 +211,33 @@ pub fn region_distance(
 /// Thresholds of the labelling rule. Defaults are the documented values.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LabelRules {
-    /// A component is emotion when its `d_emotion` is at least this multiple of the median
-    /// `d_emotion` (a clear peak). Default 2.0.
+    /// A component is emotion when its emotion distance is at least this multiple of the
+    /// median over components (a clear peak). Default 3.0.
     pub emotion_peak_ratio: f64,
-    /// …and at least this share of the largest `d_emotion` (several peaks allowed). Default 0.6.
+    /// …and at least this share of the largest (several peaks allowed). Default 0.5.
     pub emotion_share_of_max: f64,
-    /// A component belongs to a region when its `|d_region|` is at least this share of the
-    /// largest `|d_region|` of that region among the non-emotion components. Default 0.25.
-    pub region_share_of_max: f64,
+    /// A component takes a region's role when that region holds at least this share of its
+    /// `|d_region|` summed over the role regions. Default 0.5.
+    pub region_share_of_component: f64,
+    /// …and its `|d_region|` there is at least this share of the region's largest among the
+    /// non-emotion components, so that near-silent (noise) components stay `other`.
+    /// Default 0.02.
+    pub region_floor_of_max: f64,
 }
 
 impl Default for LabelRules {
     fn default() -> LabelRules {
         LabelRules {
-            emotion_peak_ratio: 2.0,
-            emotion_share_of_max: 0.6,
-            region_share_of_max: 0.25,
+            emotion_peak_ratio: 3.0,
+            emotion_share_of_max: 0.5,
+            region_share_of_component: 0.5,
+            region_floor_of_max: 0.02,
         }
     }
 }
 
-/// The emotion component(s): the clear peaks of `d_emotion` under `rules`.
+/// The emotion component(s): the clear peaks of an emotion distance (`d_level` or `d_emotion`)
+/// under `rules`.
 pub fn emotion_components(d_emotion: &[f64], rules: &LabelRules) -> Vec<usize> {
     let mut sorted = d_emotion.to_vec();
     sorted.sort_by(f64::total_cmp);
@@ -226,9 +258,11 @@ pub fn emotion_components(d_emotion: &[f64], rules: &LabelRules) -> Vec<usize> {
 }
 
 /// Roles from the metrics. `regions` holds `(role, d_region per component)` for the regions that
-/// decide roles (mouth → speech, eyebrows, eyelids). Each non-emotion component takes the region
-/// where its `|d_region|`, relative to that region's largest, is highest — if that relative value
-/// reaches `rules.region_share_of_max`; otherwise it is `Other`.
+/// decide roles (mouth → speech, eyebrows, eyelids). A non-emotion component takes the role of
+/// the region holding at least `rules.region_share_of_component` of its summed `|d_region|`,
+/// provided it moves that region by at least `rules.region_floor_of_max` of the region's
+/// largest; otherwise it is `Other`. The share is per component, so a weak component that acts
+/// only on the mouth is still speech.
 pub fn label(
     m: usize,
     emotion: &[usize],
@@ -249,14 +283,21 @@ pub fn label(
             if emotion.contains(&i) {
                 return Role::Emotion;
             }
-            let mut best = (Role::Other, 0.0);
-            for ((role, d), &max) in regions.iter().zip(&maxima) {
-                let rel = if max > 0.0 { d[i].abs() / max } else { 0.0 };
-                if rel >= rules.region_share_of_max && rel > best.1 {
-                    best = (*role, rel);
+            let total: f64 = regions.iter().map(|(_, d)| d[i].abs()).sum();
+            let best = regions
+                .iter()
+                .zip(&maxima)
+                .max_by(|a, b| a.0 .1[i].abs().total_cmp(&b.0 .1[i].abs()));
+            match best {
+                Some(((role, d), &max))
+                    if total > 0.0
+                        && d[i].abs() >= rules.region_share_of_component * total
+                        && d[i].abs() >= rules.region_floor_of_max * max =>
+                {
+                    *role
                 }
+                _ => Role::Other,
             }
-            best.0
         })
         .collect()
 }

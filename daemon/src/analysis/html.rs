@@ -22,6 +22,11 @@ pub fn page(report: &Report) -> String {
             c.role,
             c.d_emotion.map_or("—".into(), |d| format!("{d:.4}"))
         );
+        let _ = write!(
+            rows,
+            "<td>{}</td>",
+            c.d_level.map_or("—".into(), |d| format!("{d:.4}"))
+        );
         for r in &regions {
             let _ = write!(rows, "<td>{:.4}</td>", c.d_region[*r]);
         }
@@ -61,9 +66,11 @@ components follow the words.</p>
 <img src="timeline.svg" alt="component series over alternating-emotion takes">
 <h2>Levels</h2><ul>{levels}</ul>
 <h2>Metrics</h2>
-<table><tr><th>component</th><th>role</th><th>d_emotion</th>{header}<th>|M_k| mm</th></tr>{rows}</table>
-<p>Thresholds: emotion when d_emotion ≥ {r1} × median and ≥ {r2} × max; a region's role when
-|d_region| ≥ {r3} × the region's largest (the largest relative share wins).</p>
+<table><tr><th>component</th><th>role</th><th>d_emotion</th><th>d_level</th>{header}<th>|M_k| mm</th></tr>{rows}</table>
+<p>Thresholds: emotion when d_level (RMS difference of paired take means) ≥ {r1} × its median
+and ≥ {r2} × its max; otherwise a component takes the role of the region holding ≥ {r3} of its
+summed |d_region| over mouth, eyebrows and eyelids, if that |d_region| is ≥ {r4} × the region's
+largest; else other.</p>
 </body></html>
 "#,
         model = report.model,
@@ -72,6 +79,7 @@ components follow the words.</p>
         pairs = report.pairs.len(),
         r1 = t.emotion_peak_ratio,
         r2 = t.emotion_share_of_max,
-        r3 = t.region_share_of_max,
+        r3 = t.region_share_of_component,
+        r4 = t.region_floor_of_max,
     )
 }

@@ -1,8 +1,11 @@
 //! `emoshift analyze`: give the components their meaning (section 4 of the method).
 //!
 //! Every take of the manifest is projected onto the model. Pairs of takes with the same
-//! sentence and different emotions give `d_emotion` (DTW-aligned RMS difference per component);
-//! its clear peak is the emotion component. Region metrics `d_region,i` on the mouth, eyebrows and
+//! sentence and different emotions give `d_emotion` (DTW-aligned RMS difference per component,
+//! the method's metric, reported and charted) and `d_level` (RMS difference of take means); the
+//! clear peak of `d_level` is the emotion component. The two agree when few components are kept;
+//! `d_level` stays clear when the variance target keeps noise components, whose `d_emotion` is
+//! about √2 because noise is independent between takes. Region metrics `d_region,i` on the mouth, eyebrows and
 //! eyelids label the speech, eyebrow and eyelid components (thresholds in
 //! [`ica_core::interpret::LabelRules`]). Each named emotion gets a level: the mean of the emotion
 //! component over that emotion's takes.
@@ -68,6 +71,9 @@ pub struct ComponentReport {
     pub role: Role,
     /// `d_emotion` (absent without pairs).
     pub d_emotion: Option<f64>,
+    /// `d_level`: RMS over pairs of the difference of take means (absent without pairs); its
+    /// clear peak labels emotion.
+    pub d_level: Option<f64>,
     /// `d_region` for every region of the regions file.
     pub d_region: BTreeMap<String, f64>,
     /// Marker-space displacement of one unit of the component (mm, mixing column norm).
@@ -198,8 +204,8 @@ pub fn analyze(
     let rules = LabelRules::default();
     let series: Vec<Vec<f64>> = takes.iter().map(|t| t.projected.as_f64()).collect();
     let pairs = pairs_of(takes);
-    let (d_emotion, pair_summaries) = if pairs.is_empty() {
-        (None, Vec::new())
+    let (d_emotion, d_level, pair_summaries) = if pairs.is_empty() {
+        (None, None, Vec::new())
     } else {
         let refs: Vec<(&[f64], &[f64])> = pairs
             .iter()
@@ -208,6 +214,7 @@ pub fn analyze(
         let longest = series.iter().map(|s| s.len() / m).max().unwrap_or(0);
         let band = ((longest as f64) * DTW_BAND_SHARE).ceil() as usize;
         let d = interpret::emotion_distance(&refs, m, Some(band))?;
+        let level = interpret::level_distance(&refs, m)?;
         let summaries = pairs
             .iter()
             .zip(&d.aligned_samples)
@@ -218,9 +225,9 @@ pub fn analyze(
                 aligned_samples: q,
             })
             .collect();
-        (Some(d.per_component), summaries)
+        (Some(d.per_component), Some(level), summaries)
     };
-    let emotion = d_emotion
+    let emotion = d_level
         .as_deref()
         .map(|d| interpret::emotion_components(d, &rules))
         .unwrap_or_default();
@@ -245,7 +252,7 @@ pub fn analyze(
         (None, _) => "emotion not measured: the manifest has no pair of takes with the same \
                       sentence in two different emotions"
             .to_string(),
-        (Some(_), true) => "no clear peak in d_emotion: no component is labelled emotion".into(),
+        (Some(_), true) => "no clear peak in d_level: no component is labelled emotion".into(),
         (Some(_), false) => String::new(),
     };
     let components = (0..m)
@@ -253,6 +260,7 @@ pub fn analyze(
             index: k,
             role: roles[k],
             d_emotion: d_emotion.as_ref().map(|d| d[k]),
+            d_level: d_level.as_ref().map(|d| d[k]),
             d_region: d_region.iter().map(|(n, d)| (n.clone(), d[k])).collect(),
             mixing_norm_mm: model.mixing().column(k).norm(),
         })
@@ -293,7 +301,7 @@ pub fn analyze(
     })
 }
 
-/// The emotion component the levels are measured on: the largest `d_emotion` among the peaks.
+/// The emotion component the levels are measured on: the largest `d_level` among the peaks.
 fn main_emotion(emotion: &[usize], d: Option<&[f64]>) -> Option<usize> {
     let d = d?;
     emotion
@@ -332,7 +340,7 @@ pub fn write_into_model(model: &mut IcaModel, report: &Report) -> Result<()> {
         report
             .components
             .iter()
-            .map(|c| c.d_emotion)
+            .map(|c| c.d_level)
             .collect::<Option<Vec<f64>>>()
             .as_deref(),
     );

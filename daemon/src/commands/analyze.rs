@@ -26,10 +26,11 @@ pub(crate) fn run(args: &AnalyzeArgs) -> Result<()> {
     let written = analysis::write_report(&args.out, &report, &takes)?;
     for c in &report.components {
         crate::out!(
-            "c{:<2} {:<9} d_emotion {:>8} d_mouth {:>8.4} d_eyebrows {:>8.4} d_eyelids {:>8.4}",
+            "c{:<2} {:<9} d_emotion {:>8} d_level {:>8} d_mouth {:>8.4} d_eyebrows {:>8.4} d_eyelids {:>8.4}",
             c.index,
             format!("{:?}", c.role).to_lowercase(),
             c.d_emotion.map_or("-".into(), |d| format!("{d:.4}")),
+            c.d_level.map_or("-".into(), |d| format!("{d:.4}")),
             c.d_region["mouth"],
             c.d_region["eyebrows"],
             c.d_region["eyelids"]

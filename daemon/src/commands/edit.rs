@@ -1,12 +1,23 @@
-//! `emoshift edit --model m.json FILE --out OUT [--translate k=a]... [--gain k=g]...`.
+//! `emoshift edit`: component-space edits of a take, by index or by emotion name.
+//!
+//! - `--translate k=a`, `--gain k=g`: raw edits (section 5, *Translate*).
+//! - `--to-emotion NAME [--amount x]`: translate the emotion component by
+//!   `x · (level[NAME] − mean of the take's emotion component)`.
+//! - `--replace-emotion-from OTHER`: *Copy & Replace*, the other take's emotion series,
+//!   DTW-aligned to this take on the non-emotion components.
+//! - `--add-emotion-from OTHER --other-model m2.json`: *Copy & Add*, `x = mean₁ + M₁u₁ +
+//!   M₂ (u₂ᵀe_E) e_E` with `u₂` the other take under the second model, aligned likewise.
+
+use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use ica_core::model::IcaModel;
+use ica_core::project::Projector;
 use replay::Take;
 
 use crate::cli::{EditArgs, KeyValue};
 use crate::exit::UsageError;
-use crate::offline::{self, ModelFrames};
+use crate::offline::{self, ModelFrames, Projected};
 
 fn check_component(model: &IcaModel, kv: &KeyValue, flag: &str) -> Result<usize> {
     if kv.key >= model.components() {
@@ -22,27 +33,162 @@ fn check_component(model: &IcaModel, kv: &KeyValue, flag: &str) -> Result<usize>
     Ok(kv.key)
 }
 
+/// The emotion component of a model, or a clear error telling how to get one.
+fn emotion_component(model: &IcaModel, path: &Path) -> Result<usize> {
+    model.emotion().component.ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: the model has no emotion component yet; run `emoshift analyze --write-model` on a paired session first",
+            path.display()
+        )
+    })
+}
+
+/// A take projected under a model, ready to align.
+fn project_other(model: &IcaModel, path: &Path) -> Result<Projected> {
+    let take = offline::load_take(path)?;
+    let map = offline::match_take(model, &take, path)?;
+    offline::project_take(model, &offline::to_model_order(&take, &map))
+}
+
+/// Component `k` of `other`, resampled onto `this` take's timeline by DTW on the other
+/// components (each take's means removed).
+fn aligned_component(this: &Projected, other: &Projected, k: usize) -> Result<Vec<f64>> {
+    let m = this.m;
+    let strip = |p: &Projected| -> Vec<f64> {
+        p.u.chunks_exact(m)
+            .flat_map(|row| (0..m).filter(|&j| j != k).map(move |j| f64::from(row[j])))
+            .collect()
+    };
+    let (a, b) = (strip(this), strip(other));
+    let dim = (m - 1).max(1);
+    let (a, b) = if m == 1 {
+        (this.as_f64(), other.as_f64())
+    } else {
+        (a, b)
+    };
+    let n = a.len() / dim;
+    let band = (n.max(b.len() / dim) as f64 * crate::analysis::DTW_BAND_SHARE).ceil() as usize;
+    let demean = |s: &[f64]| -> Vec<f64> {
+        let frames = (s.len() / dim).max(1) as f64;
+        let mut mean = vec![0.0; dim];
+        for row in s.chunks_exact(dim) {
+            for (acc, v) in mean.iter_mut().zip(row) {
+                *acc += v / frames;
+            }
+        }
+        s.iter()
+            .enumerate()
+            .map(|(i, v)| v - mean[i % dim])
+            .collect()
+    };
+    let alignment = ica_core::dtw::align(&demean(&a), &demean(&b), dim, Some(band))?;
+    let map = ica_core::dtw::warp_map(&alignment.path, n);
+    let values = other.component(k);
+    Ok(map
+        .iter()
+        .map(|&j| {
+            let lo = j.floor() as usize;
+            let hi = (lo + 1).min(values.len() - 1);
+            let t = j - lo as f64;
+            values[lo] * (1.0 - t) + values[hi] * t
+        })
+        .collect())
+}
+
+/// The per-frame edit plan.
+struct Plan {
+    offsets: Vec<f32>,
+    gains: Vec<f32>,
+    /// Component replaced by a value per frame.
+    replace: Option<(usize, Vec<f64>)>,
+    /// A second model's component added per frame.
+    add: Option<(IcaModel, usize, Vec<f64>)>,
+}
+
+fn plan(
+    args: &EditArgs,
+    model: &IcaModel,
+    projected: &Projected,
+    frames: &ModelFrames,
+) -> Result<Plan> {
+    let m = model.components();
+    let mut plan = Plan {
+        offsets: vec![0.0; m],
+        gains: vec![1.0; m],
+        replace: None,
+        add: None,
+    };
+    for kv in &args.translate {
+        plan.offsets[check_component(model, kv, "--translate")?] += kv.value as f32;
+    }
+    for kv in &args.gain {
+        plan.gains[check_component(model, kv, "--gain")?] *= kv.value as f32;
+    }
+    if let Some(name) = &args.to_emotion {
+        let k = emotion_component(model, &args.model)?;
+        let levels = &model.emotion().levels;
+        let Some(level) = levels.get(name) else {
+            let known: Vec<&String> = levels.keys().collect();
+            return Err(UsageError(format!(
+                "--to-emotion {name}: the model knows the emotions {known:?}"
+            ))
+            .into());
+        };
+        if !(0.0..=1.0).contains(&args.amount) {
+            return Err(UsageError(format!("--amount {} is outside 0..1", args.amount)).into());
+        }
+        let current = projected.component(k).iter().sum::<f64>() / frames.frames().max(1) as f64;
+        plan.offsets[k] += (args.amount * (level - current)) as f32;
+    }
+    if let Some(other) = &args.replace_emotion_from {
+        let k = emotion_component(model, &args.model)?;
+        let other_u = project_other(model, other)?;
+        plan.replace = Some((k, aligned_component(projected, &other_u, k)?));
+    }
+    if let Some(other) = &args.add_emotion_from {
+        let Some(path) = &args.other_model else {
+            return Err(UsageError("--add-emotion-from needs --other-model m2.json".into()).into());
+        };
+        let model2 = super::load_model(path)?;
+        if model2.labels() != model.labels() {
+            bail!(
+                "{}: Copy & Add needs both models to have the same markers in the same order",
+                path.display()
+            );
+        }
+        let k2 = emotion_component(&model2, path)?;
+        let this2 = offline::project_take(&model2, frames)?;
+        let other_u = project_other(&model2, other)?;
+        let values = aligned_component(&this2, &other_u, k2)?;
+        plan.add = Some((model2, k2, values));
+    }
+    Ok(plan)
+}
+
 pub(crate) fn run(args: &EditArgs) -> Result<()> {
     let model = super::load_model(&args.model)?;
     let take = offline::load_take(&args.file)?;
     let map = offline::match_take(&model, &take, &args.file)?;
     let frames = offline::to_model_order(&take, &map);
     let projected = offline::project_take(&model, &frames)?;
-    let mut offsets = vec![0.0f32; model.components()];
-    let mut gains = vec![1.0f32; model.components()];
-    for kv in &args.translate {
-        offsets[check_component(&model, kv, "--translate")?] += kv.value as f32;
-    }
-    for kv in &args.gain {
-        gains[check_component(&model, kv, "--gain")?] *= kv.value as f32;
-    }
-    let edited = offline::resynthesise(&model, &projected, |_, edit| {
-        for k in 0..offsets.len() {
-            // Values were checked above; a failure here is an internal invariant.
-            let _ = edit.set_offset(k, offsets[k]);
-            let _ = edit.set_gain(k, gains[k]);
+    let plan = plan(args, &model, &projected, &frames)?;
+    let mut edited = offline::resynthesise(&model, &projected, |f, edit| {
+        for k in 0..plan.offsets.len() {
+            // Indices and values were checked when the plan was made.
+            let _ = edit.set_offset(k, plan.offsets[k]);
+            let _ = edit.set_gain(k, plan.gains[k]);
+        }
+        if let Some((k, values)) = &plan.replace {
+            let _ = edit.set_override(*k, Some(values[f] as f32));
         }
     })?;
+    if let Some((model2, k2, values)) = &plan.add {
+        let second = Projector::new(model2);
+        let channels = model.channels();
+        for (f, frame) in edited.chunks_exact_mut(channels).enumerate() {
+            second.add_component_into(*k2, values[f] as f32, frame)?;
+        }
+    }
     let out = assemble(&take, model.labels(), &map, &frames, edited, args.keep_gaps)?;
     replay::save(&args.out, &out).with_context(|| format!("{}", args.out.display()))?;
     crate::out!("edited {} frames -> {}", out.n_frames(), args.out.display());
