@@ -20,10 +20,13 @@ pub const MIN_OBSERVABILITY: f64 = 1e-2;
 #[derive(Debug, Clone)]
 pub(crate) struct MaskedSolver {
     m: usize,
-    /// `M` row-major (n x m), f64: the Gram update reads whole rows.
-    rows: Vec<f64>,
+    /// Each marker's contribution to `MᵀM` (its three rows' outer products), packed lower
+    /// triangles back to back: a hidden marker costs one contiguous subtraction of
+    /// m(m+1)/2 values instead of three rank-one updates.
+    blocks: Vec<f64>,
     gram_full: Vec<f64>,
     pivots_full: Vec<f64>,
+    /// Packed lower triangles (row `i` is `[off(i), off(i) + i]`), m x m.
     gram: Vec<f64>,
     factor: Vec<f64>,
     pivots: Vec<f64>,
@@ -38,23 +41,41 @@ pub(crate) struct Solve {
     pub ill_conditioned: bool,
 }
 
+/// Start of row `i` in a packed lower triangle.
+fn off(i: usize) -> usize {
+    i * (i + 1) / 2
+}
+
 impl MaskedSolver {
-    /// `mixing_rows`: `M` row-major, n x m, of full column rank (the model guarantees it).
-    pub(crate) fn new(mixing_rows: Vec<f64>, m: usize) -> MaskedSolver {
+    /// `mixing_rows`: `M` row-major, n x m (n = markers x 3), of full column rank (the model
+    /// guarantees it).
+    pub(crate) fn new(mixing_rows: &[f64], m: usize) -> MaskedSolver {
+        let tri = off(m);
+        let markers = mixing_rows.len() / (3 * m);
+        let mut blocks = vec![0.0; markers * tri];
+        for (block, rows) in blocks
+            .chunks_exact_mut(tri)
+            .zip(mixing_rows.chunks_exact(3 * m))
+        {
+            for row in rows.chunks_exact(m) {
+                add_outer(block, row);
+            }
+        }
+        let mut gram_full = vec![0.0; tri];
+        for block in blocks.chunks_exact(tri) {
+            add_into(&mut gram_full, block, 1.0);
+        }
         let mut s = MaskedSolver {
             m,
-            rows: mixing_rows,
-            gram_full: vec![0.0; m * m],
+            blocks,
+            gram_full,
             pivots_full: vec![0.0; m],
-            gram: vec![0.0; m * m],
-            factor: vec![0.0; m * m],
+            gram: vec![0.0; tri],
+            factor: vec![0.0; tri],
             pivots: vec![0.0; m],
             rhs: vec![0.0; m],
             sol: vec![0.0; m],
         };
-        for row in s.rows.chunks_exact(m) {
-            add_outer(&mut s.gram_full, row, m, 1.0);
-        }
         s.factor.copy_from_slice(&s.gram_full);
         let ok = cholesky(&mut s.factor, &mut s.pivots_full, m);
         assert!(
@@ -64,14 +85,14 @@ impl MaskedSolver {
         s
     }
 
-    /// Solves for `u` given the centred frame `c` (missing channels already zeroed, so
-    /// `Mᵀc = M_oᵀ c_o`), the per-channel `observed` mask with `hidden` channels hidden,
-    /// and the `prior` used when the frame is ill-conditioned.
+    /// Solves for `u` given `rhs` = `Mᵀc` for the centred frame `c` with missing channels
+    /// zeroed (so it equals `M_oᵀ c_o`), the per-marker `hidden` flags (`hidden_count` of
+    /// them set), and the `prior` used when the frame is ill-conditioned.
     pub(crate) fn solve(
         &mut self,
         rhs: impl Iterator<Item = f64>,
-        observed: &[bool],
-        hidden: usize,
+        hidden: impl Iterator<Item = bool> + Clone,
+        hidden_count: usize,
         prior: &[f32],
         u: &mut [f32],
     ) -> Solve {
@@ -79,7 +100,7 @@ impl MaskedSolver {
         for (r, v) in self.rhs.iter_mut().zip(rhs) {
             *r = v;
         }
-        self.build_gram(observed, hidden);
+        self.build_gram(hidden, hidden_count);
         self.factor.copy_from_slice(&self.gram);
         let ok = cholesky(&mut self.factor, &mut self.pivots, m);
         let observability = if ok {
@@ -105,22 +126,23 @@ impl MaskedSolver {
         }
     }
 
-    /// `M_oᵀ M_o`, by downdating the full Gram with the hidden rows when they are the
-    /// minority (cheap for a few occluded markers) and by summing the observed rows otherwise
-    /// (the downdate would cancel most of the full Gram and lose digits).
-    fn build_gram(&mut self, observed: &[bool], hidden: usize) {
-        let m = self.m;
-        let downdate = hidden * 2 <= observed.len();
+    /// `M_oᵀ M_o`, by subtracting the hidden markers' blocks from the full Gram when they are
+    /// the minority (cheap for a few occluded markers) and by summing the observed blocks
+    /// otherwise (the subtraction would cancel most of the full Gram and lose digits).
+    fn build_gram(&mut self, hidden: impl Iterator<Item = bool> + Clone, hidden_count: usize) {
+        let tri = off(self.m);
+        let markers = self.blocks.len() / tri;
+        let downdate = hidden_count * 2 <= markers;
         if downdate {
             self.gram.copy_from_slice(&self.gram_full);
         } else {
             self.gram.fill(0.0);
         }
-        for (row, &obs) in self.rows.chunks_exact(m).zip(observed) {
-            if downdate && !obs {
-                add_outer(&mut self.gram, row, m, -1.0);
-            } else if !downdate && obs {
-                add_outer(&mut self.gram, row, m, 1.0);
+        for (block, gone) in self.blocks.chunks_exact(tri).zip(hidden) {
+            if downdate && gone {
+                add_into(&mut self.gram, block, -1.0);
+            } else if !downdate && !gone {
+                add_into(&mut self.gram, block, 1.0);
             }
         }
     }
@@ -128,35 +150,40 @@ impl MaskedSolver {
     /// Ridge toward `prior`: `(G + λD) u = b + λD prior` with `D = diag(MᵀM)`, `λ =`
     /// [`MIN_OBSERVABILITY`]. Positive definite whatever is hidden, since `D > 0`.
     fn regularise(&mut self, prior: &[f32]) {
-        let m = self.m;
         self.factor.copy_from_slice(&self.gram);
         for (k, (r, &p)) in self.rhs.iter_mut().zip(prior).enumerate() {
-            let d = MIN_OBSERVABILITY * self.gram_full[k * m + k];
-            self.factor[k * m + k] += d;
+            let kk = off(k) + k;
+            let d = MIN_OBSERVABILITY * self.gram_full[kk];
+            self.factor[kk] += d;
             *r += d * f64::from(p);
         }
-        let ok = cholesky(&mut self.factor, &mut self.pivots, m);
+        let ok = cholesky(&mut self.factor, &mut self.pivots, self.m);
         debug_assert!(ok, "G + λD is positive definite for λ > 0 and D > 0");
     }
 }
 
-/// `g += sign · r rᵀ`, lower triangle only (the factorisation reads nothing else).
-fn add_outer(g: &mut [f64], r: &[f64], m: usize, sign: f64) {
-    for i in 0..m {
-        let ri = sign * r[i];
-        let gi = &mut g[i * m..i * m + i + 1];
-        for (gij, rj) in gi.iter_mut().zip(&r[..=i]) {
+/// `g += r rᵀ` on a packed lower triangle.
+fn add_outer(g: &mut [f64], r: &[f64]) {
+    for (i, &ri) in r.iter().enumerate() {
+        for (gij, rj) in g[off(i)..off(i) + i + 1].iter_mut().zip(r) {
             *gij += ri * rj;
         }
     }
 }
 
-/// In-place lower Cholesky `A = L Lᵀ` of a row-major m x m matrix, reading only the lower
-/// triangle; `pivots[j] = L_jj²`. Returns false at the first non-positive pivot.
+/// `g += sign · block`, element-wise.
+fn add_into(g: &mut [f64], block: &[f64], sign: f64) {
+    for (gi, bi) in g.iter_mut().zip(block) {
+        *gi += sign * bi;
+    }
+}
+
+/// In-place Cholesky `A = L Lᵀ` of a packed lower triangle; `pivots[j] = L_jj²`. Returns
+/// false at the first non-positive pivot.
 fn cholesky(a: &mut [f64], pivots: &mut [f64], m: usize) -> bool {
     for j in 0..m {
-        let (head, below) = a.split_at_mut((j + 1) * m);
-        let row_j = &mut head[j * m..];
+        let (head, below) = a.split_at_mut(off(j + 1));
+        let row_j = &mut head[off(j)..];
         let d = row_j[j] - row_j[..j].iter().map(|v| v * v).sum::<f64>();
         if d.is_nan() || d <= 0.0 {
             return false;
@@ -164,8 +191,9 @@ fn cholesky(a: &mut [f64], pivots: &mut [f64], m: usize) -> bool {
         pivots[j] = d;
         let ljj = d.sqrt();
         row_j[j] = ljj;
-        let row_j = &head[j * m..];
-        for row_i in below.chunks_exact_mut(m) {
+        let row_j = &head[off(j)..];
+        for i in (j + 1)..m {
+            let row_i = &mut below[off(i) - off(j + 1)..off(i + 1) - off(j + 1)];
             let s: f64 = row_i[..j].iter().zip(&row_j[..j]).map(|(x, y)| x * y).sum();
             row_i[j] = (row_i[j] - s) / ljj;
         }
@@ -173,19 +201,19 @@ fn cholesky(a: &mut [f64], pivots: &mut [f64], m: usize) -> bool {
     true
 }
 
-/// Solves `L Lᵀ x = b` with the factor from [`cholesky`].
+/// Solves `L Lᵀ x = b` with the packed factor from [`cholesky`].
 fn solve_factored(l: &[f64], b: &[f64], x: &mut [f64], m: usize) {
     for i in 0..m {
-        let s: f64 = l[i * m..i * m + i]
+        let s: f64 = l[off(i)..off(i) + i]
             .iter()
             .zip(&x[..i])
             .map(|(a, y)| a * y)
             .sum();
-        x[i] = (b[i] - s) / l[i * m + i];
+        x[i] = (b[i] - s) / l[off(i) + i];
     }
     for i in (0..m).rev() {
-        let s: f64 = ((i + 1)..m).map(|k| l[k * m + i] * x[k]).sum();
-        x[i] = (x[i] - s) / l[i * m + i];
+        let s: f64 = ((i + 1)..m).map(|k| l[off(k) + i] * x[k]).sum();
+        x[i] = (x[i] - s) / l[off(i) + i];
     }
 }
 
@@ -195,15 +223,15 @@ mod tests {
 
     #[test]
     fn cholesky_solves_a_known_system() {
-        // A = [[4, 2], [2, 3]], b = A [1, -2] = [0, -4]
-        let mut a = vec![4.0, 0.0, 2.0, 3.0];
+        // A = [[4, 2], [2, 3]] packed lower, b = A [1, -2] = [0, -4]
+        let mut a = vec![4.0, 2.0, 3.0];
         let mut piv = vec![0.0; 2];
         assert!(cholesky(&mut a, &mut piv, 2));
         assert_eq!(piv, vec![4.0, 2.0]);
         let mut x = vec![0.0; 2];
         solve_factored(&a, &[0.0, -4.0], &mut x, 2);
         assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] + 2.0).abs() < 1e-12);
-        let mut singular = vec![1.0, 0.0, 1.0, 1.0];
+        let mut singular = vec![1.0, 1.0, 1.0];
         assert!(!cholesky(&mut singular, &mut piv, 2));
     }
 }

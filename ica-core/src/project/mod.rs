@@ -109,7 +109,7 @@ impl Projector {
         };
         // nalgebra is column-major already.
         let mixing = model.mixing().iter().map(|&v| v as f32).collect();
-        let rows = (0..n)
+        let rows: Vec<f64> = (0..n)
             .flat_map(|j| (0..m).map(move |k| model.mixing()[(j, k)]))
             .collect();
         Projector {
@@ -122,7 +122,7 @@ impl Projector {
             centered: vec![0.0; n],
             observed: vec![true; n],
             last_u: vec![0.0; m],
-            solver: MaskedSolver::new(rows, m),
+            solver: MaskedSolver::new(&rows, m),
         }
     }
 
@@ -314,9 +314,10 @@ impl Projector {
         let rhs = mixing
             .chunks_exact(n)
             .map(|col| f64::from(kernels::dot(col, centered)));
+        let hidden_markers = self.observed.iter().step_by(3).map(|&obs| !obs);
         let solve = self
             .solver
-            .solve(rhs, &self.observed, hidden, &self.last_u, u);
+            .solve(rhs, hidden_markers, missing_markers, &self.last_u, u);
         status.observability = solve.observability as f32;
         status.ill_conditioned = solve.ill_conditioned;
         self.last_u.copy_from_slice(u);
