@@ -144,7 +144,7 @@ pub fn decode_osc(msg: &[u8]) -> Result<OscMessage, DecodeError> {
 ///
 /// # Errors
 /// [`ControlError`] naming the address and the bad argument; the daemon sends its text back
-/// with [`encode_error_into`].
+/// with [`crate::encode_error_into`].
 pub fn decode_control(msg: &[u8]) -> Result<Control, ControlError> {
     let m = decode_osc(msg)?;
     parse_control(&m.addr, m.args)

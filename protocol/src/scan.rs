@@ -366,7 +366,8 @@ mod tests {
 
     #[test]
     fn thousands_of_bundle_headers_do_not_overflow() {
-        // the shape that crashes rosc: each bundle's one element claims the rest of the datagram
+        // the shape that aborts rosc 0.11 (stack overflow at 3,000 levels, 60 KB, on a 2 MiB
+        // thread, measured): each bundle's one element claims the rest of the datagram
         let levels = 3000;
         let mut d = Vec::new();
         for level in 0..levels {

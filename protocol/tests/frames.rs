@@ -169,3 +169,15 @@ fn encoding_refuses_non_finite_present_markers_and_reuses_the_buffer() {
     assert_eq!(f.header().missing_count, 0);
     encode_frame_into(&f, &mut out).expect("finite again");
 }
+
+#[test]
+fn a_109_marker_compact_bundle_fits_one_ethernet_payload() {
+    let mut f = FrameBuf::new();
+    f.set_frame(1, 2, &face(109)).expect("valid");
+    let mut out = Vec::new();
+    let n = protocol::encode_compact_into(&f, "neutral", 0.5, &mut out).expect("valid");
+    assert_eq!(n, 1_424);
+    let long = "x".repeat(55);
+    let n = protocol::encode_compact_into(&f, &long, 0.5, &mut out).expect("valid");
+    assert_eq!(n, protocol::ETHERNET_PAYLOAD);
+}
