@@ -20,10 +20,17 @@ fuzz_target!(|data: &[u8]| {
     assert_eq!(m.args[1], OscType::Long(h.capture_time_us));
     let floats: Vec<f32> = match h.form {
         FrameForm::Blob => {
-            let OscType::Blob(pos) = &m.args[3] else { panic!("positions blob") };
-            pos.chunks_exact(4).map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]])).collect()
+            let OscType::Blob(pos) = &m.args[3] else {
+                panic!("positions blob")
+            };
+            pos.chunks_exact(4)
+                .map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]]))
+                .collect()
         }
-        FrameForm::Flat => m.args[2..].iter().map(|a| a.clone().float().expect("float")).collect(),
+        FrameForm::Flat => m.args[2..]
+            .iter()
+            .map(|a| a.clone().float().expect("float"))
+            .collect(),
     };
     assert_eq!(floats.len(), buf.positions().len());
     for (i, (a, b)) in floats.iter().zip(buf.positions()).enumerate() {
