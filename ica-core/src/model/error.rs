@@ -153,6 +153,12 @@ pub enum ModelError {
         /// Name of the level.
         name: String,
     },
+    /// Frame-preparation settings do not fit the model.
+    #[error("capture settings: {problem}")]
+    BadCapture {
+        /// What is wrong, e.g. `head reference marker 120 is outside the 109 markers`.
+        problem: String,
+    },
     /// The training report describes a different shape than the matrices.
     #[error("training report says {what} = {got}, but the model has {expected}")]
     ReportMismatch {

@@ -19,7 +19,8 @@
 
 use super::json_rows::RowsFormatter;
 use super::{
-    check_finite, check_parts, check_pseudo_inverse, EmotionLevels, IcaModel, ModelError, Role,
+    check_finite, check_parts, check_pseudo_inverse, CaptureSettings, EmotionLevels, IcaModel,
+    ModelError, Role,
 };
 use crate::report::TrainReport;
 use nalgebra::DMatrix;
@@ -42,6 +43,9 @@ struct ModelFile {
     #[serde(default)]
     emotion: EmotionLevels,
     report: TrainReport,
+    // Omitted when default, so models without head stabilisation keep their version-1 bytes.
+    #[serde(default, skip_serializing_if = "CaptureSettings::is_default")]
+    capture: CaptureSettings,
 }
 
 /// Only the version, read first so that a future layout fails with
@@ -67,6 +71,7 @@ impl IcaModel {
             roles: self.roles.clone(),
             emotion: self.emotion.clone(),
             report: self.report.clone(),
+            capture: self.capture.clone(),
         };
         let mut ser = serde_json::Serializer::with_formatter(writer, RowsFormatter::default());
         file.serialize(&mut ser).map_err(ModelError::Write)?;
@@ -152,6 +157,7 @@ fn from_file(file: ModelFile) -> Result<IcaModel, ModelError> {
     {
         return Err(ModelError::NonFiniteLevel { name: name.clone() });
     }
+    super::check_capture(&file.capture, file.labels.len())?;
     Ok(IcaModel {
         labels: file.labels,
         rate_hz: file.rate_hz,
@@ -161,6 +167,7 @@ fn from_file(file: ModelFile) -> Result<IcaModel, ModelError> {
         roles,
         emotion: file.emotion,
         report: file.report,
+        capture: file.capture,
     })
 }
 

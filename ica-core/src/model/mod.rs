@@ -72,6 +72,28 @@ pub struct IcaModel {
     roles: Vec<Role>,
     emotion: EmotionLevels,
     report: TrainReport,
+    capture: CaptureSettings,
+}
+
+/// How frames are prepared before projection, stored so that `project`, `edit` and the daemon
+/// all do exactly what training did.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CaptureSettings {
+    /// Head stabilisation: the rigid reference markers and their template. `None` models the
+    /// face in capture coordinates.
+    #[serde(default)]
+    pub head: Option<crate::stabilise::HeadReference>,
+    /// Marker speed (mm/s) above which a sample is a glitch (a swap or spike) and is treated
+    /// as missing. `None` disables the check.
+    #[serde(default)]
+    pub max_speed_mm_s: Option<f64>,
+}
+
+impl CaptureSettings {
+    /// True when nothing is set (no stabilisation, no glitch check).
+    pub fn is_default(&self) -> bool {
+        *self == CaptureSettings::default()
+    }
 }
 
 impl IcaModel {
@@ -101,6 +123,7 @@ impl IcaModel {
             roles,
             emotion: EmotionLevels::default(),
             report,
+            capture: CaptureSettings::default(),
         })
     }
 
@@ -157,6 +180,22 @@ impl IcaModel {
     /// The emotion component and its named levels.
     pub fn emotion(&self) -> &EmotionLevels {
         &self.emotion
+    }
+
+    /// Frame preparation (head stabilisation, glitch threshold).
+    pub fn capture(&self) -> &CaptureSettings {
+        &self.capture
+    }
+
+    /// Sets the frame preparation.
+    ///
+    /// # Errors
+    /// [`ModelError::BadCapture`] for a reference marker outside the model, a template of the
+    /// wrong length or not finite, or a non-positive speed limit.
+    pub fn set_capture(&mut self, capture: CaptureSettings) -> Result<(), ModelError> {
+        check_capture(&capture, self.markers())?;
+        self.capture = capture;
+        Ok(())
     }
 
     /// What training did.
@@ -374,3 +413,31 @@ fn check_pseudo_inverse(mixing: &DMatrix<f64>, unmixing: &DMatrix<f64>) -> Resul
 
 #[cfg(test)]
 mod tests;
+
+/// Checks stored frame-preparation settings against the marker count.
+pub(crate) fn check_capture(capture: &CaptureSettings, markers: usize) -> Result<(), ModelError> {
+    let bad = |problem: String| Err(ModelError::BadCapture { problem });
+    if let Some(head) = &capture.head {
+        if let Some(&index) = head.markers.iter().find(|&&i| i >= markers) {
+            return bad(format!(
+                "head reference marker {index} is outside the {markers} markers"
+            ));
+        }
+        if head.markers.len() < 3 || head.template.len() != head.markers.len() {
+            return bad(format!(
+                "head reference needs 3 or more markers with one template point each, got {} markers and {} points",
+                head.markers.len(),
+                head.template.len()
+            ));
+        }
+        if head.template.iter().flatten().any(|v| !v.is_finite()) {
+            return bad("head reference template is not finite".into());
+        }
+    }
+    if let Some(v) = capture.max_speed_mm_s {
+        if !(v.is_finite() && v > 0.0) {
+            return bad(format!("max_speed_mm_s must be positive, got {v}"));
+        }
+    }
+    Ok(())
+}
