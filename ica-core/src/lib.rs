@@ -5,9 +5,11 @@ pub mod dtw;
 pub mod edit;
 pub mod fastica;
 pub mod fit;
+pub mod interpret;
 pub mod model;
 pub mod project;
 pub mod report;
+pub mod stabilise;
 pub mod whiten;
 
 pub use report::{RestartReport, TrainReport};
