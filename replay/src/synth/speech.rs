@@ -141,8 +141,8 @@ pub struct BrowEvent {
 }
 
 /// Rise and fall widths of a brow raise (canonical seconds).
-const BROW_RISE_S: f64 = 0.12;
-const BROW_FALL_S: f64 = 0.25;
+const BROW_RISE_S: f64 = 0.15;
+const BROW_FALL_S: f64 = 0.35;
 
 /// A sentence: fixed content shared by every take that utters it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -225,7 +225,7 @@ impl Sentence {
             let fall = (-((t - centre).abs() / width).powf(1.5)).exp();
             let stress = f64::from(seg.stress);
             let mut target = seg.viseme.targets();
-            target[0] *= 1.0 + 0.25 * stress;
+            target[0] *= 1.0 + 0.15 * stress;
             target[1] *= 1.0 + 0.1 * stress;
             target[2] *= 1.0 + 0.1 * stress;
             let alpha = seg.viseme.dominance();
@@ -271,8 +271,9 @@ fn stress_pattern(rng: &mut impl Rng, n: usize, phrase_break: Option<usize>) -> 
     stress
 }
 
-/// Brow raises peak just after the stressed vowel's centre: every primary stress, a quarter of
-/// the secondary ones.
+/// Brow raises lead the accent, peaking at the stressed vowel's onset and decaying over the
+/// next syllable or two: every primary stress, a quarter of the secondary ones. (Peaking on the
+/// vowel centre would tie them to the jaw opening far more than real brows are.)
 fn brow_events(rng: &mut impl Rng, segs: &[Segment]) -> Vec<BrowEvent> {
     let mut events = Vec::new();
     for seg in segs.iter().filter(|s| s.stress > 0) {
@@ -281,7 +282,7 @@ fn brow_events(rng: &mut impl Rng, segs: &[Segment]) -> Vec<BrowEvent> {
             _ if rng.random_bool(0.25) => rng.random_range(0.4..0.7),
             _ => continue,
         };
-        let peak_s = 0.5 * (seg.start_s + seg.end_s) + 0.05;
+        let peak_s = seg.start_s;
         events.push(BrowEvent { peak_s, amplitude });
     }
     events
