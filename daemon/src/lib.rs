@@ -9,6 +9,7 @@ pub mod analysis;
 pub mod cli;
 pub mod commands;
 pub mod exit;
+pub mod frame;
 pub mod layout;
 pub mod logging;
 pub mod offline;

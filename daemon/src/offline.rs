@@ -6,10 +6,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use ica_core::edit::FrameEdit;
 use ica_core::model::IcaModel;
-use ica_core::project::{FrameStatus, Projector};
+use ica_core::project::FrameStatus;
 use replay::session::Session;
 use replay::Take;
 
+use crate::frame::{FrameProcessor, Prepared};
 use crate::layout::LabelMap;
 
 /// A take loaded from disk, with where it came from.
@@ -118,13 +119,15 @@ pub fn match_take(model: &IcaModel, take: &Take, path: &Path) -> Result<LabelMap
     LabelMap::new(model.labels(), &take.labels).with_context(|| format!("{}", path.display()))
 }
 
-/// Component series of a take: frames x m (`f32`), with each frame's projection status.
+/// Component series of a take: frames x m (`f32`), with what preparing each frame found.
 #[derive(Debug, Clone)]
 pub struct Projected {
     /// Components, frames x m.
     pub u: Vec<f32>,
-    /// Per-frame status (masked, held...).
+    /// Per-frame projection status (masked, held...).
     pub status: Vec<FrameStatus>,
+    /// Per-frame preparation (head pose, glitches).
+    pub prepared: Vec<Prepared>,
     /// Components per frame.
     pub m: usize,
 }
@@ -142,27 +145,41 @@ impl Projected {
     pub fn as_f64(&self) -> Vec<f64> {
         self.u.iter().map(|&v| f64::from(v)).collect()
     }
+
+    /// Samples dropped as glitches over the take.
+    pub fn glitches(&self) -> usize {
+        self.prepared.iter().map(|p| p.glitches).sum()
+    }
 }
 
-/// Projects every frame of a take (masked where markers are missing).
+/// Projects every frame of a take through the shared [`FrameProcessor`] (glitch check, head
+/// stabilisation, masked projection).
 ///
 /// # Errors
 /// A frame buffer that does not match the model (an internal invariant).
 pub fn project_take(model: &IcaModel, frames: &ModelFrames) -> Result<Projected> {
-    let mut projector = Projector::new(model);
+    let mut processor = FrameProcessor::new(model);
     let m = model.components();
     let n = frames.frames();
     let mut u = vec![0.0f32; n * m];
     let mut status = Vec::with_capacity(n);
+    let mut prepared = Vec::with_capacity(n);
     for f in 0..n {
         let (xyz, missing) = frames.frame(f);
-        let st = projector.project_masked_into(xyz, Some(missing), &mut u[f * m..(f + 1) * m])?;
-        status.push(st);
+        let p = processor.project(xyz, missing, &mut u[f * m..(f + 1) * m])?;
+        status.push(p.status);
+        prepared.push(p);
     }
-    Ok(Projected { u, status, m })
+    Ok(Projected {
+        u,
+        status,
+        prepared,
+        m,
+    })
 }
 
-/// Resynthesises a take from (edited) components, one [`FrameEdit`] per frame produced by `edit`.
+/// Resynthesises a take from (edited) components, one [`FrameEdit`] per frame produced by `edit`,
+/// putting each frame's head pose back.
 ///
 /// # Errors
 /// A buffer that does not match the model (an internal invariant).
@@ -171,7 +188,7 @@ pub fn resynthesise(
     projected: &Projected,
     mut edit: impl FnMut(usize, &mut FrameEdit),
 ) -> Result<Vec<f32>> {
-    let projector = Projector::new(model);
+    let mut processor = FrameProcessor::new(model);
     let m = projected.m;
     let channels = model.channels();
     let frames = projected.u.len() / m.max(1);
@@ -182,7 +199,12 @@ pub fn resynthesise(
         edit(f, &mut frame_edit);
         u.copy_from_slice(&projected.u[f * m..(f + 1) * m]);
         frame_edit.apply(&mut u)?;
-        projector.resynth_into(&u, &mut out[f * channels..(f + 1) * channels])?;
+        let pose = projected.prepared[f].pose;
+        processor.resynthesise(
+            pose.as_ref(),
+            &u,
+            &mut out[f * channels..(f + 1) * channels],
+        )?;
     }
     Ok(out)
 }
