@@ -15,6 +15,14 @@
 
 /// Observability below which a masked frame is flagged ill-conditioned and regularised
 /// (1%: a component whose independent footprint is 99% hidden).
+///
+/// A frame with missing markers is projected by least squares on the observed rows, through
+/// the m x m normal equations and a Cholesky factorisation in f64. Its observability is
+/// `min_k p_k(observed) / p_k(full)` over the Cholesky pivots `p_k` (the energy of column `k`
+/// of `M` not explained by columns `0..k`), in `[0, 1]` since hiding rows only shrinks
+/// pivots. Below this threshold the solve adds a ridge `λ·diag(MᵀM)` (λ = this value) toward
+/// the last good components (or 0, the mean pose), so components the visible markers cannot
+/// see hold still instead of exploding, while the others follow the data up to a ~1% pull.
 pub const MIN_OBSERVABILITY: f64 = 1e-2;
 
 #[derive(Debug, Clone)]

@@ -18,7 +18,7 @@
 //! `M·u` is a sum of column axpys, four columns per pass over the output.
 //!
 //! **Missing markers** (a `missing` mask, or any non-finite coordinate) are handled by
-//! least squares on the observed rows; see [`masked`] for the method and the
+//! least squares on the observed rows; see [`MIN_OBSERVABILITY`] for the method and the
 //! [`FrameStatus`] flags.
 
 mod kernels;
