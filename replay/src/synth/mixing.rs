@@ -121,10 +121,16 @@ fn smoothstep(a: f64, b: f64, x: f64) -> f64 {
     t * t * (3.0 - 2.0 * t)
 }
 
-/// Gaussian falloff around the nearer of the two mirrored centres (±cx, cy).
+/// Smooth falloff around the nearer of the two mirrored centres (±cx, cy): a compact Wendland
+/// C2 kernel reaching zero at 3 x `radius`, so a field never leaks onto distant regions.
 fn bump(m: &Marker, cx: f64, cy: f64, radius: f64) -> f64 {
     let (x, y) = (m.rest[0].abs(), m.rest[1]);
-    (-((x - cx).powi(2) + (y - cy).powi(2)) / (2.0 * radius * radius)).exp()
+    let q = ((x - cx).powi(2) + (y - cy).powi(2)).sqrt() / (3.0 * radius);
+    if q >= 1.0 {
+        0.0
+    } else {
+        (1.0 - q).powi(4) * (4.0 * q + 1.0)
+    }
 }
 
 fn side(m: &Marker) -> f64 {
@@ -234,5 +240,50 @@ fn blink(m: &Marker) -> [f64; 3] {
         l if l.starts_with("LidUpper") => [0.0, -9.0, -2.0],
         l if l.starts_with("LidLower") => [0.0, 1.5, 0.0],
         _ => [0.0; 3],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn moved(m: &[f64], marker: usize, source: usize) -> f64 {
+        (0..3)
+            .map(|a| m[(marker * 3 + a) * SOURCE_COUNT + source].powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    #[test]
+    fn each_field_stays_in_its_regions() {
+        let face = FaceGeometry::standard();
+        let m = mixing_matrix(&face);
+        let upper = [Region::Eyebrows, Region::Eyelids, Region::Forehead];
+        for (i, mk) in face.markers.iter().enumerate() {
+            for s in 0..SPEECH_SOURCE_NAMES.len() {
+                if upper.contains(&mk.region) || mk.region == Region::HeadReference {
+                    assert_eq!(moved(&m, i, s), 0.0, "speech {s} moves {}", mk.label);
+                }
+            }
+            if mk.region == Region::Mouth {
+                assert!(moved(&m, i, 0) > 0.5 || mk.label.starts_with("UpperLip"));
+                assert!(moved(&m, i, 1) > 1.0 && moved(&m, i, 2) > 1.0);
+            }
+            let lid = mk.region == Region::Eyelids;
+            assert_eq!(moved(&m, i, BLINK) > 0.0, lid, "blink on {}", mk.label);
+            let brow = matches!(mk.region, Region::Eyebrows | Region::Forehead)
+                || mk.label.starts_with("LidUpper");
+            assert_eq!(moved(&m, i, BROW_RAISE) > 0.0, brow, "brow on {}", mk.label);
+            let face_part = matches!(
+                mk.region,
+                Region::Mouth | Region::Cheeks | Region::Eyebrows | Region::Eyelids
+            );
+            if face_part && !mk.label.starts_with("Cheek") {
+                assert!(moved(&m, i, EMOTION) > 0.3, "emotion on {}", mk.label);
+            }
+            if mk.region == Region::HeadReference {
+                assert_eq!(moved(&m, i, EMOTION), 0.0);
+            }
+        }
     }
 }
