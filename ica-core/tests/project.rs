@@ -43,8 +43,12 @@ fn model_from(mixing: DMatrix<f64>, rng: &mut ChaCha8Rng) -> IcaModel {
 }
 
 fn random_model(seed: u64) -> (IcaModel, ChaCha8Rng) {
+    random_model_m(seed, M)
+}
+
+fn random_model_m(seed: u64, m: usize) -> (IcaModel, ChaCha8Rng) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mixing = DMatrix::from_fn(N, M, |_, _| normal(&mut rng));
+    let mixing = DMatrix::from_fn(N, m, |_, _| normal(&mut rng));
     (model_from(mixing, &mut rng), rng)
 }
 
@@ -75,23 +79,25 @@ fn max_abs_diff(a: &[f32], b: &[f64]) -> f64 {
 
 #[test]
 fn full_frame_matches_the_f64_model_to_f32_precision() {
-    let (model, mut rng) = random_model(1);
-    let mut p = Projector::new(&model);
-    let (mut u, mut out) = (vec![0.0_f32; M], vec![0.0_f32; N]);
-    for _ in 0..20 {
-        let (x, x32) = frame(&model, &random_u(&mut rng, M), 0.5, &mut rng);
-        p.project_into(&x32, &mut u).expect("sizes match");
-        let want = model.unmixing() * (&x - DVector::from_column_slice(model.mean()));
-        // |u| ~ 3, W entries ~ 1/18: f32 rounding of x (6e-5 mm) and of the sums stays < 1e-4.
-        assert!(
-            max_abs_diff(&u, want.as_slice()) < 1e-4,
-            "u off by {}",
-            max_abs_diff(&u, want.as_slice())
-        );
-        p.resynth_into(&u, &mut out).expect("sizes match");
-        let back = DVector::from_column_slice(model.mean()) + model.mixing() * &want;
-        // Coordinates ~1000 mm: f32 spacing 6e-5 mm, plus M·(u error).
-        assert!(max_abs_diff(&out, back.as_slice()) < 5e-4);
+    // Every kernel: paired narrow panels (m <= 8), wide panels (m <= 32), rows (m > 32),
+    // and remainders of the four-column resynthesis.
+    for m in [1, 3, 6, 10, 20, 33] {
+        let (model, mut rng) = random_model_m(u64::try_from(m).expect("small"), m);
+        let mut p = Projector::new(&model);
+        let (mut u, mut out) = (vec![0.0_f32; m], vec![0.0_f32; N]);
+        for _ in 0..5 {
+            let (x, x32) = frame(&model, &random_u(&mut rng, m), 0.5, &mut rng);
+            p.project_into(&x32, &mut u).expect("sizes match");
+            let want = model.unmixing() * (&x - DVector::from_column_slice(model.mean()));
+            // |u| ~ 3, W entries ~ 1/18: f32 rounding of x (6e-5 mm) and of the sums < 1e-4.
+            let err = max_abs_diff(&u, want.as_slice());
+            assert!(err < 1e-4, "m = {m}: u off by {err}");
+            p.resynth_into(&u, &mut out).expect("sizes match");
+            let back = DVector::from_column_slice(model.mean()) + model.mixing() * &want;
+            // Coordinates ~1000 mm: f32 spacing 6e-5 mm, plus M·(u error).
+            let err = max_abs_diff(&out, back.as_slice());
+            assert!(err < 5e-4, "m = {m}: x off by {err}");
+        }
     }
 }
 

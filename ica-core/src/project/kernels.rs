@@ -26,13 +26,16 @@ pub(crate) fn dot(a: &[f32], b: &[f32]) -> f32 {
 }
 
 /// Panel widths [`panel_gemv`] is instantiated for.
-pub(crate) const PANEL_WIDTHS: [usize; 4] = [8, 16, 24, 32];
+pub(crate) const PANEL_WIDTHS: [usize; 8] = [4, 8, 12, 16, 20, 24, 28, 32];
 
 /// `u = W (x − mean)` for `wt` = `Wᵀ` as n rows of `K` (zero padded from `u.len()` to `K`
 /// columns): `acc += (x_j − mean_j) · wt[j]`. With `K` known at compile time the accumulator
 /// lives in registers and each row is a handful of vector multiply-adds.
 #[inline]
 pub(crate) fn panel_gemv<const K: usize>(wt: &[f32], x: &[f32], mean: &[f32], u: &mut [f32]) {
+    if K <= 8 {
+        return panel_gemv_pairs::<K>(wt, x, mean, u);
+    }
     let mut acc = [0.0_f32; K];
     for ((row, &xj), &mj) in wt.chunks_exact(K).zip(x).zip(mean) {
         let cj = xj - mj;
@@ -41,6 +44,34 @@ pub(crate) fn panel_gemv<const K: usize>(wt: &[f32], x: &[f32], mean: &[f32], u:
         }
     }
     u.copy_from_slice(&acc[..u.len()]);
+}
+
+/// [`panel_gemv`] for narrow panels: with one or two registers of accumulator every row
+/// would wait on the previous row's add, so even and odd rows accumulate separately
+/// (measured 458 -> 382 ns per frame at m = 6; wider panels have enough independent lanes
+/// already and slow down from the register pressure).
+fn panel_gemv_pairs<const K: usize>(wt: &[f32], x: &[f32], mean: &[f32], u: &mut [f32]) {
+    let (mut even, mut odd) = ([0.0_f32; K], [0.0_f32; K]);
+    let rows = wt.chunks_exact(2 * K);
+    let last = rows.remainder();
+    let (xs, ms) = (x.chunks_exact(2), mean.chunks_exact(2));
+    let (x_last, m_last) = (xs.remainder(), ms.remainder());
+    for ((pair, xp), mp) in rows.zip(xs).zip(ms) {
+        let (c0, c1) = (xp[0] - mp[0], xp[1] - mp[1]);
+        let (r0, r1) = pair.split_at(K);
+        for i in 0..K {
+            even[i] += c0 * r0[i];
+            odd[i] += c1 * r1[i];
+        }
+    }
+    if let (Some(&xj), Some(&mj)) = (x_last.first(), m_last.first()) {
+        for i in 0..K {
+            even[i] += (xj - mj) * last[i];
+        }
+    }
+    for ((o, e), d) in u.iter_mut().zip(&even).zip(&odd) {
+        *o = e + d;
+    }
 }
 
 fn reduce(acc: [f32; LANES]) -> f32 {
