@@ -1,0 +1,140 @@
+//! FastICA (Hyvärinen 1999) on whitened data, with seeded restarts.
+//!
+//! The input is the `m x T` whitened matrix `Z` from [`crate::whiten`]; the output is an
+//! orthogonal `m x m` rotation `W` with `u = W z` as independent as the contrast can make them.
+//! Each restart draws its start from a ChaCha8 stream seeded with
+//! `seed + k * 0x9E37_79B9_7F4A_7C15` (restart `k`, wrapping), so results depend on the seed
+//! only: there are no threads and no clock.
+
+mod contrast;
+mod deflation;
+mod gemm;
+mod symmetric;
+
+pub use contrast::Contrast;
+pub(crate) use gemm::{mul_add, strided};
+
+use nalgebra::DMatrix;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+
+use crate::RestartReport;
+
+/// The update rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Algorithm {
+    /// All components at once, re-orthogonalised symmetrically each step (the default).
+    #[default]
+    Symmetric,
+    /// One component at a time with Gram-Schmidt against the earlier ones.
+    Deflation,
+}
+
+impl Algorithm {
+    /// Name as written in the training report: `symmetric` or `deflation`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Algorithm::Symmetric => "symmetric",
+            Algorithm::Deflation => "deflation",
+        }
+    }
+}
+
+/// Odd multiplier of the golden ratio: spreads restart seeds across the u64 range.
+const RESTART_SEED_STEP: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// Seed of restart `k` derived from the base seed.
+pub fn restart_seed(seed: u64, k: usize) -> u64 {
+    seed.wrapping_add((k as u64).wrapping_mul(RESTART_SEED_STEP))
+}
+
+/// What one run of the update ended with.
+#[derive(Debug)]
+pub(crate) struct Outcome {
+    pub w: DMatrix<f64>,
+    pub iterations: usize,
+    pub converged: bool,
+    pub last_delta: f64,
+}
+
+/// Settings of the iteration (checked by the caller).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Settings {
+    pub contrast: Contrast,
+    pub algorithm: Algorithm,
+    pub tol: f64,
+    pub max_iter: usize,
+    pub seed: u64,
+    pub restarts: usize,
+}
+
+/// The kept rotation and every restart's diagnostics.
+#[derive(Debug)]
+pub(crate) struct IcaRun {
+    /// Orthogonal `m x m` rotation of the whitened data.
+    pub w: DMatrix<f64>,
+    /// The kept solution's sources, `T x m` (one component per column).
+    pub sources: DMatrix<f64>,
+    pub restarts: Vec<RestartReport>,
+    pub best: usize,
+}
+
+/// Runs `restarts` seeded restarts on `z` (`m x T`) and keeps the best.
+///
+/// "Best" is the largest total negentropy approximation `sum_i (E G(u_i) - E G(nu))^2` among the
+/// converged restarts; only when none converged does it fall back to all of them, since an
+/// unconverged rotation may stop half-way between two separations. Ties keep the earlier one.
+pub(crate) fn run(z: &DMatrix<f64>, s: Settings) -> IcaRun {
+    let (m, frames) = z.shape();
+    let gaussian = s.contrast.gaussian_expectation();
+    let mut ws = symmetric::Workspace::new(m, frames);
+    let mut best: Option<(usize, f64, DMatrix<f64>, DMatrix<f64>)> = None;
+    let mut reports = Vec::with_capacity(s.restarts);
+    for k in 0..s.restarts {
+        let seed = restart_seed(s.seed, k);
+        let w0 = random_start(m, seed);
+        let out = match s.algorithm {
+            Algorithm::Symmetric => symmetric::run(z, w0, s.contrast, s.tol, s.max_iter, &mut ws),
+            Algorithm::Deflation => deflation::run(z, &w0, s.contrast, s.tol, s.max_iter),
+        };
+        symmetric::sources_into(z, &out.w, &mut ws.gy);
+        let negentropy: f64 = ws
+            .gy
+            .as_slice()
+            .chunks_exact(frames)
+            .map(|col| s.contrast.negentropy(col, gaussian))
+            .sum();
+        reports.push(RestartReport {
+            seed,
+            iterations: out.iterations,
+            converged: out.converged,
+            last_delta: out.last_delta,
+            negentropy,
+        });
+        let better = match &best {
+            None => true,
+            Some((b, score, _, _)) => {
+                let (b_conv, conv) = (reports[*b].converged, out.converged);
+                (conv && !b_conv) || (conv == b_conv && negentropy > *score)
+            }
+        };
+        if better {
+            best = Some((k, negentropy, out.w, ws.gy.clone()));
+        }
+    }
+    let (best, _, w, sources) = best.expect("restarts >= 1 is checked before fitting");
+    IcaRun {
+        w,
+        sources,
+        restarts: reports,
+        best,
+    }
+}
+
+/// A standard-normal `m x m` start drawn from the restart's seed (rows are orthonormalised by the
+/// update itself).
+fn random_start(m: usize, seed: u64) -> DMatrix<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    DMatrix::from_fn(m, m, |_, _| StandardNormal.sample(&mut rng))
+}

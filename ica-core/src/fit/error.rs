@@ -1,0 +1,91 @@
+//! Why a fit was refused.
+
+use thiserror::Error;
+
+/// Everything that makes [`crate::fit::FastIcaParams::fit`] refuse its input or parameters.
+///
+/// Numerical non-convergence is *not* an error: it is reported per restart in
+/// [`crate::TrainReport`], because a slightly unconverged ICA is still usable and the caller
+/// decides.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum FitError {
+    /// The data has no channels.
+    #[error("data has no channels")]
+    NoChannels,
+    /// The sample slice is not a whole number of frames.
+    #[error("{len} samples are not a whole number of frames of {channels} channels")]
+    RaggedSamples {
+        /// Length of the sample slice.
+        len: usize,
+        /// Channels per frame.
+        channels: usize,
+    },
+    /// The missing-sample mask does not have one flag per sample.
+    #[error("missing-sample mask has {got} flags, expected {expected} (frames x channels)")]
+    MaskLength {
+        /// Samples in the data.
+        expected: usize,
+        /// Flags in the mask.
+        got: usize,
+    },
+    /// A sample marked present is NaN or infinite.
+    #[error("sample at frame {frame}, channel {channel} is not finite ({value})")]
+    NonFinite {
+        /// Frame index.
+        frame: usize,
+        /// Channel index.
+        channel: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// Too few complete frames to estimate the statistics.
+    #[error("only {used} of {total} frames are complete, at least {needed} are needed")]
+    TooFewFrames {
+        /// Frames without missing samples.
+        used: usize,
+        /// Frames offered.
+        total: usize,
+        /// Frames required.
+        needed: usize,
+    },
+    /// Every channel is constant or missing.
+    #[error("all {channels} channels are constant or missing")]
+    NoVariance {
+        /// Channels offered.
+        channels: usize,
+    },
+    /// A fixed component count of zero.
+    #[error("component count must be at least 1, got 0")]
+    ZeroComponents,
+    /// A fixed component count above the rank of the data.
+    #[error("m = {m} is larger than the data's rank ({rank})")]
+    ComponentsExceedRank {
+        /// Requested components.
+        m: usize,
+        /// Numerical rank of the covariance of the complete frames.
+        rank: usize,
+    },
+    /// A variance target outside the accepted range.
+    #[error("variance target {target} is outside [{min}, {max}]")]
+    VarianceTarget {
+        /// The target given.
+        target: f64,
+        /// Smallest accepted target.
+        min: f64,
+        /// Largest accepted target.
+        max: f64,
+    },
+    /// A tolerance that is not a positive finite number.
+    #[error("tolerance must be positive and finite, got {tol}")]
+    Tolerance {
+        /// The tolerance given.
+        tol: f64,
+    },
+    /// An iteration cap of zero.
+    #[error("max_iter must be at least 1, got 0")]
+    ZeroIterations,
+    /// A restart count of zero.
+    #[error("restarts must be at least 1, got 0")]
+    ZeroRestarts,
+}

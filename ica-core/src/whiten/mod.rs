@@ -1,0 +1,198 @@
+//! Centring and PCA whitening (section 3.2 of the paper: `x = E{x} + P A u`).
+//!
+//! The covariance of the complete frames is accumulated in f64 (blocked gemm, upper triangle
+//! only), decomposed with nalgebra's `SymmetricEigen`, and the principal axes are sorted by
+//! variance. The first `m` axes, each scaled to unit variance, whiten the data; FastICA then
+//! only has to find a rotation of them.
+
+mod stats;
+
+use nalgebra::{DMatrix, SymmetricEigen};
+
+use crate::fit::{FitData, FitError};
+
+/// Smallest accepted variance target.
+pub const MIN_VARIANCE_TARGET: f64 = 0.90;
+/// Largest accepted variance target.
+pub const MAX_VARIANCE_TARGET: f64 = 0.999;
+/// Default variance target.
+pub const DEFAULT_VARIANCE_TARGET: f64 = 0.97;
+/// A channel whose variance is at most this share of the largest channel variance is dead
+/// (constant marker, or a channel missing in every frame): it gets no loading and no weight.
+pub const DEAD_CHANNEL_RELATIVE_VARIANCE: f64 = 1e-9;
+/// Eigenvalues at most this share of the largest one count as numerically zero for the rank.
+pub const RANK_RELATIVE_EIGENVALUE: f64 = 1e-10;
+
+/// How many principal components (and so independent components) to keep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Components {
+    /// The smallest `m` whose principal components explain at least this share of the variance,
+    /// in [`MIN_VARIANCE_TARGET`, `MAX_VARIANCE_TARGET`].
+    VarianceTarget(f64),
+    /// Exactly `m` components; at least 1 and at most the data's rank.
+    Fixed(usize),
+}
+
+impl Default for Components {
+    fn default() -> Self {
+        Components::VarianceTarget(DEFAULT_VARIANCE_TARGET)
+    }
+}
+
+impl Components {
+    /// Checks the parameter alone (the rank check needs the data).
+    ///
+    /// # Errors
+    /// [`FitError::VarianceTarget`] or [`FitError::ZeroComponents`].
+    pub fn check(self) -> Result<(), FitError> {
+        match self {
+            Components::VarianceTarget(t)
+                if !(MIN_VARIANCE_TARGET..=MAX_VARIANCE_TARGET).contains(&t) =>
+            {
+                Err(FitError::VarianceTarget {
+                    target: t,
+                    min: MIN_VARIANCE_TARGET,
+                    max: MAX_VARIANCE_TARGET,
+                })
+            }
+            Components::Fixed(0) => Err(FitError::ZeroComponents),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Centred, whitened training data and the PCA that produced it.
+#[derive(Debug, Clone)]
+pub struct Whitening {
+    /// Per-channel mean over the used frames (channels long; 0 for channels missing everywhere).
+    pub mean: Vec<f64>,
+    /// Channels with about zero variance, ascending.
+    pub dead_channels: Vec<usize>,
+    /// The other channels, ascending: rows of `basis`.
+    pub live_channels: Vec<usize>,
+    /// Eigenvalues of the live covariance, largest first, negatives clamped to 0.
+    pub eigenvalues: Vec<f64>,
+    /// Numerical rank of the covariance.
+    pub rank: usize,
+    /// Share of the total variance explained by the kept components.
+    pub variance_kept: f64,
+    /// The kept principal axes, `live x m`, orthonormal columns, largest variance first.
+    pub basis: DMatrix<f64>,
+    /// Whitened used frames, `m x used` (one frame per column, unit covariance).
+    pub whitened: DMatrix<f64>,
+    /// Indices of the frames used (no missing sample), ascending.
+    pub used_frames: Vec<usize>,
+    /// Frames offered.
+    pub frames_total: usize,
+}
+
+impl Whitening {
+    /// Components kept (`m`).
+    pub fn components(&self) -> usize {
+        self.basis.ncols()
+    }
+}
+
+/// Centres and whitens `data`, keeping `components` principal components.
+///
+/// # Errors
+/// Non-finite present samples, fewer than `m + 1` (at least 2) complete frames, all channels
+/// dead, a bad variance target, `m == 0` or `m` above the rank: see [`FitError`].
+pub fn whiten<T: Copy + Into<f64>>(
+    data: &FitData<'_, T>,
+    components: Components,
+) -> Result<Whitening, FitError> {
+    components.check()?;
+    let sel = stats::select(data)?;
+    let needed = match components {
+        Components::Fixed(m) => m + 1,
+        Components::VarianceTarget(_) => 2,
+    }
+    .max(2);
+    let used = sel.used_frames.len();
+    if used < needed {
+        return Err(FitError::TooFewFrames {
+            used,
+            total: data.frames(),
+            needed,
+        });
+    }
+    let mut mean = stats::mean(data, &sel);
+    let var = stats::variances(data, &sel, &mean);
+    let max_var = var.iter().copied().fold(0.0f64, f64::max);
+    if max_var <= 0.0 {
+        return Err(FitError::NoVariance {
+            channels: data.channels(),
+        });
+    }
+    let (live, dead): (Vec<usize>, Vec<usize>) = (0..data.channels()).partition(|&c| {
+        !sel.always_missing[c] && var[c] > DEAD_CHANNEL_RELATIVE_VARIANCE * max_var
+    });
+    // A constant channel keeps its constant as mean (so the reconstruction is right); one never
+    // seen has mean 0 already.
+    for &c in &dead {
+        if sel.always_missing[c] {
+            mean[c] = 0.0;
+        }
+    }
+    let cov = stats::covariance(data, &sel.used_frames, &live, &mean);
+    let (eigenvalues, axes) = sorted_eigen(cov);
+    let lmax = eigenvalues.first().copied().unwrap_or(0.0);
+    let rank = eigenvalues
+        .iter()
+        .take_while(|&&l| l > RANK_RELATIVE_EIGENVALUE * lmax)
+        .count();
+    let m = choose_m(components, &eigenvalues, rank)?;
+    let total: f64 = eigenvalues.iter().sum();
+    let variance_kept = eigenvalues[..m].iter().sum::<f64>() / total;
+    let basis = axes.columns(0, m).into_owned();
+    let mut rows = basis.transpose();
+    for (i, mut row) in rows.row_iter_mut().enumerate() {
+        row /= eigenvalues[i].sqrt();
+    }
+    let whitened = stats::project(data, &sel.used_frames, &live, &mean, &rows);
+    Ok(Whitening {
+        mean,
+        dead_channels: dead,
+        live_channels: live,
+        eigenvalues,
+        rank,
+        variance_kept,
+        basis,
+        whitened,
+        used_frames: sel.used_frames,
+        frames_total: data.frames(),
+    })
+}
+
+/// Eigen-decomposes a symmetric matrix; returns eigenvalues (clamped at 0) largest first and the
+/// matching unit eigenvectors as columns.
+fn sorted_eigen(cov: DMatrix<f64>) -> (Vec<f64>, DMatrix<f64>) {
+    let eig = SymmetricEigen::new(cov);
+    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
+    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+    let values = order.iter().map(|&i| eig.eigenvalues[i].max(0.0)).collect();
+    let vectors = DMatrix::from_fn(eig.eigenvectors.nrows(), order.len(), |r, c| {
+        eig.eigenvectors[(r, order[c])]
+    });
+    (values, vectors)
+}
+
+/// Picks `m` from the request and the spectrum.
+fn choose_m(components: Components, eigenvalues: &[f64], rank: usize) -> Result<usize, FitError> {
+    match components {
+        Components::Fixed(m) if m > rank => Err(FitError::ComponentsExceedRank { m, rank }),
+        Components::Fixed(m) => Ok(m),
+        Components::VarianceTarget(target) => {
+            let total: f64 = eigenvalues.iter().sum();
+            let mut acc = 0.0;
+            for (i, &l) in eigenvalues.iter().enumerate().take(rank) {
+                acc += l;
+                if acc >= target * total {
+                    return Ok(i + 1);
+                }
+            }
+            Ok(rank.max(1))
+        }
+    }
+}

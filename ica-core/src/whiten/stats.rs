@@ -1,0 +1,183 @@
+//! One-pass-per-statistic scans of the training data: which frames count, the mean, per-channel
+//! variance, the covariance and the whitened projection. All sums are in f64.
+
+use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
+
+use crate::fastica::{mul_add, strided};
+
+use crate::fit::{FitData, FitError};
+
+/// Frames gathered per gemm call: large enough to amortise packing, small enough to stay in cache.
+const CHUNK_FRAMES: usize = 256;
+
+/// Channel block edge for the triangular covariance: only blocks on or above the diagonal are
+/// multiplied, saving close to half the flops of a full `X^T X`.
+const COV_BLOCK: usize = 96;
+
+/// Which frames and channels take part.
+#[derive(Debug)]
+pub(crate) struct Selection {
+    /// Frames with no missing sample (on channels that are not missing everywhere).
+    pub used_frames: Vec<usize>,
+    /// Channels missing in every frame.
+    pub always_missing: Vec<bool>,
+}
+
+/// Checks every present sample is finite and picks the complete frames.
+pub(crate) fn select<T: Copy + Into<f64>>(data: &FitData<'_, T>) -> Result<Selection, FitError> {
+    let (frames, channels) = (data.frames(), data.channels());
+    let mut missing_count = vec![0usize; channels];
+    for f in 0..frames {
+        let values = data.frame(f);
+        let flags = data.frame_missing(f);
+        for (c, &v) in values.iter().enumerate() {
+            if flags.is_some_and(|m| m[c]) {
+                missing_count[c] += 1;
+                continue;
+            }
+            let value: f64 = v.into();
+            if !value.is_finite() {
+                return Err(FitError::NonFinite {
+                    frame: f,
+                    channel: c,
+                    value,
+                });
+            }
+        }
+    }
+    let always_missing: Vec<bool> = missing_count
+        .iter()
+        .map(|&n| frames > 0 && n == frames)
+        .collect();
+    let used_frames = (0..frames)
+        .filter(|&f| match data.frame_missing(f) {
+            None => true,
+            Some(flags) => flags
+                .iter()
+                .zip(&always_missing)
+                .all(|(&miss, &dead)| !miss || dead),
+        })
+        .collect();
+    Ok(Selection {
+        used_frames,
+        always_missing,
+    })
+}
+
+/// Per-channel mean over the used frames (0 for channels missing everywhere).
+pub(crate) fn mean<T: Copy + Into<f64>>(data: &FitData<'_, T>, sel: &Selection) -> Vec<f64> {
+    let mut sum = vec![0.0f64; data.channels()];
+    for &f in &sel.used_frames {
+        for ((s, &v), &dead) in sum.iter_mut().zip(data.frame(f)).zip(&sel.always_missing) {
+            if !dead {
+                *s += v.into();
+            }
+        }
+    }
+    let n = sel.used_frames.len().max(1) as f64;
+    sum.iter_mut().for_each(|s| *s /= n);
+    sum
+}
+
+/// Per-channel unbiased variance over the used frames (two-pass, around the exact mean).
+pub(crate) fn variances<T: Copy + Into<f64>>(
+    data: &FitData<'_, T>,
+    sel: &Selection,
+    mean: &[f64],
+) -> Vec<f64> {
+    let mut sum = vec![0.0f64; data.channels()];
+    for &f in &sel.used_frames {
+        for (c, (s, &v)) in sum.iter_mut().zip(data.frame(f)).enumerate() {
+            if !sel.always_missing[c] {
+                let d = v.into() - mean[c];
+                *s += d * d;
+            }
+        }
+    }
+    let dof = (sel.used_frames.len().max(2) - 1) as f64;
+    sum.iter_mut().for_each(|s| *s /= dof);
+    sum
+}
+
+/// Calls `each(start, chunk)` with the used frames, `CHUNK_FRAMES` at a time, centred and
+/// restricted to `live` channels: `chunk` is `live.len() x frames` column-major (one frame per
+/// column), ready for gemm.
+fn for_each_chunk<T: Copy + Into<f64>>(
+    data: &FitData<'_, T>,
+    used: &[usize],
+    live: &[usize],
+    mean: &[f64],
+    mut each: impl FnMut(usize, &[f64], DMatrixView<'_, f64>),
+) {
+    let nl = live.len();
+    let mut buf = vec![0.0f64; nl * CHUNK_FRAMES];
+    for (k, frames) in used.chunks(CHUNK_FRAMES).enumerate() {
+        for (col, &f) in buf.chunks_exact_mut(nl).zip(frames) {
+            let values = data.frame(f);
+            for (dst, &c) in col.iter_mut().zip(live) {
+                *dst = values[c].into() - mean[c];
+            }
+        }
+        let raw = &buf[..nl * frames.len()];
+        each(
+            k * CHUNK_FRAMES,
+            raw,
+            DMatrixView::from_slice(raw, nl, frames.len()),
+        );
+    }
+}
+
+/// Unbiased covariance of the live channels over the used frames, `live x live`.
+pub(crate) fn covariance<T: Copy + Into<f64>>(
+    data: &FitData<'_, T>,
+    used: &[usize],
+    live: &[usize],
+    mean: &[f64],
+) -> DMatrix<f64> {
+    let nl = live.len();
+    let mut cov = DMatrix::<f64>::zeros(nl, nl);
+    for_each_chunk(data, used, live, mean, |_, raw, chunk| {
+        accumulate_upper(&mut cov, raw, chunk);
+    });
+    // Mirror the upper block triangle into the lower one.
+    for j in 0..nl {
+        for i in (j + 1)..nl {
+            cov[(i, j)] = cov[(j, i)];
+        }
+    }
+    let dof = (used.len().max(2) - 1) as f64;
+    cov /= dof;
+    cov
+}
+
+/// `cov[I, J] += chunk[I, :] chunk[J, :]^T` for channel blocks `I <= J` (a blocked syrk).
+fn accumulate_upper(cov: &mut DMatrix<f64>, data: &[f64], chunk: DMatrixView<'_, f64>) {
+    let (nl, frames) = chunk.shape();
+    for i0 in (0..nl).step_by(COV_BLOCK) {
+        let bi = COV_BLOCK.min(nl - i0);
+        let a = chunk.rows(i0, bi);
+        for j0 in (i0..nl).step_by(COV_BLOCK) {
+            let bj = COV_BLOCK.min(nl - j0);
+            // chunk[J, :]^T as a strided view of the same memory: no copy.
+            let bt = strided(&data[j0..], frames, bj, nl, 1);
+            let mut out: DMatrixViewMut<'_, f64> = cov.view_mut((i0, j0), (bi, bj));
+            mul_add(&mut out, 1.0, &a, &bt, 1.0);
+        }
+    }
+}
+
+/// Projects the used frames onto `rows` (`m x live`): returns `m x used` with one frame per column.
+pub(crate) fn project<T: Copy + Into<f64>>(
+    data: &FitData<'_, T>,
+    used: &[usize],
+    live: &[usize],
+    mean: &[f64],
+    rows: &DMatrix<f64>,
+) -> DMatrix<f64> {
+    let mut z = DMatrix::<f64>::zeros(rows.nrows(), used.len());
+    for_each_chunk(data, used, live, mean, |start, _, chunk| {
+        let mut out = z.columns_mut(start, chunk.ncols());
+        mul_add(&mut out, 1.0, rows, &chunk, 0.0);
+    });
+    z
+}

@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Times scikit-learn's FastICA on the files `fit_timing` wrote and compares with our fit.
+
+Reads, per m, DIR/data_m{m}.f32 (frames x channels), DIR/mixing_m{m}.f64 (channels x m),
+DIR/ours_unmixing_m{m}.f64 (m x channels) and our timings (JSON lines, DIR/ours.jsonl).
+sklearn runs with its defaults plus whiten="unit-variance", whiten_solver="eigh", the same m
+and tol as ours (1e-4), on float64 data (our fit computes in f64). Its default max_iter is 200;
+a second row with max_iter=1000 (our default) shows the cost of letting it converge.
+"""
+
+import argparse
+import json
+import statistics
+import time
+import warnings
+
+import numpy as np
+from sklearn.decomposition import FastICA
+from sklearn.exceptions import ConvergenceWarning
+
+
+def amari_index(p):
+    """Normalised Amari index in [0, 1], the same formula as ica_core::fit::amari_index."""
+    a = np.abs(p)
+    m = a.shape[0]
+    rows = (a.sum(axis=1) / a.max(axis=1) - 1.0).sum()
+    cols = (a.sum(axis=0) / a.max(axis=0) - 1.0).sum()
+    return (rows + cols) / (2.0 * m * (m - 1.0))
+
+
+def time_sklearn(x, m, max_iter, runs):
+    times, warned, ica = [], 0, None
+    for _ in range(runs):
+        ica = FastICA(
+            n_components=m,
+            whiten="unit-variance",
+            whiten_solver="eigh",
+            max_iter=max_iter,
+            tol=1e-4,
+            random_state=0,
+        )
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ConvergenceWarning)
+            t0 = time.perf_counter()
+            ica.fit(x)
+            times.append(time.perf_counter() - t0)
+        warned += sum(issubclass(w.category, ConvergenceWarning) for w in caught)
+    return statistics.median(times), warned, ica
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--dir", required=True)
+    ap.add_argument("--runs", type=int, default=5)
+    args = ap.parse_args()
+    ours = [json.loads(line) for line in open(f"{args.dir}/ours.jsonl") if line.strip()]
+    print(f"numpy {np.__version__}, threads: sklearn/numpy use their BLAS defaults; ours is single-threaded")
+    header = (
+        f"{'m':>3} {'ours s':>8} {'sk s':>8} {'ratio':>6} {'AI ours':>8} {'AI sk':>8} "
+        f"{'sk iter':>7} {'sk warn':>7} {'sk1000 s':>9} {'ratio':>6} {'AI sk1000':>9}  ours iterations"
+    )
+    print(header)
+    for row in ours:
+        m, frames, channels = row["m"], row["frames"], row["channels"]
+        x = np.fromfile(f"{args.dir}/data_m{m}.f32", dtype="<f4").reshape(frames, channels)
+        x = x.astype(np.float64)
+        a = np.fromfile(f"{args.dir}/mixing_m{m}.f64", dtype="<f8").reshape(channels, m)
+        w_ours = np.fromfile(f"{args.dir}/ours_unmixing_m{m}.f64", dtype="<f8").reshape(m, channels)
+        sk_s, sk_warn, ica = time_sklearn(x, m, 200, args.runs)
+        sk_ai = amari_index(ica.components_ @ a)
+        sk_iter = ica.n_iter_
+        sk2_s, _, ica2 = time_sklearn(x, m, 1000, args.runs)
+        sk2_ai = amari_index(ica2.components_ @ a)
+        our_ai = amari_index(w_ours @ a)
+        ours_s = row["median_s"]
+        print(
+            f"{m:>3} {ours_s:>8.3f} {sk_s:>8.3f} {ours_s / sk_s:>6.2f} {our_ai:>8.4f} {sk_ai:>8.4f} "
+            f"{sk_iter:>7} {sk_warn:>4}/{args.runs:<2} {sk2_s:>9.3f} {ours_s / sk2_s:>6.2f} {sk2_ai:>9.4f}  "
+            f"{row['iterations']} (whitening {row['whiten_median_s']:.3f} s)"
+        )
+
+
+if __name__ == "__main__":
+    main()
