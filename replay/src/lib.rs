@@ -10,6 +10,7 @@ pub mod c3d;
 pub mod csv;
 pub mod error;
 pub mod format;
+pub mod pacer;
 pub mod session;
 pub mod synth;
 pub mod take;
