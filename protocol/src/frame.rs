@@ -271,11 +271,7 @@ fn decode_blob_form(r: &mut Reader<'_>, buf: &mut FrameBuf) -> Result<(), Decode
     buf.set_header(frame_number, capture_time_us);
     buf.missing.extend_from_slice(mask);
     // convert every coordinate in one tight loop (it vectorises), then fix up and validate
-    buf.positions.extend(
-        coords
-            .chunks_exact(4)
-            .map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]])),
-    );
+    be_f32s_into(coords, &mut buf.positions);
     let all_present = mask.iter().all(|&b| b == 0);
     if all_present && buf.positions.iter().all(|v| v.is_finite()) {
         return Ok(());
@@ -311,11 +307,7 @@ fn decode_flat_form(
     buf.reset_empty(n, FrameForm::Flat)?;
     buf.set_header(frame_number, capture_time_us);
     buf.missing.resize(n.div_ceil(8), 0);
-    buf.positions.extend(
-        coords
-            .chunks_exact(4)
-            .map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]])),
-    );
+    be_f32s_into(coords, &mut buf.positions);
     if buf.positions.iter().all(|v| v.is_finite()) {
         return Ok(());
     }
@@ -332,6 +324,15 @@ fn decode_flat_form(
         }
     }
     Ok(())
+}
+
+/// Appends big-endian f32s (`bytes.len()` a multiple of 4) to `out`, within its capacity.
+fn be_f32s_into(bytes: &[u8], out: &mut Vec<f32>) {
+    let at = out.len();
+    out.resize(at + bytes.len() / 4, 0.0);
+    for (d, c) in out[at..].iter_mut().zip(bytes.chunks_exact(4)) {
+        *d = f32::from_be_bytes([c[0], c[1], c[2], c[3]]);
+    }
 }
 
 /// Bytes of a `,ihbb` frame message with `markers` markers (1,368 for 109).
@@ -362,20 +363,32 @@ pub(crate) fn append_frame(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<(), En
     out.extend_from_slice(&frame.missing);
     wire::pad_to4(out, start);
     wire::put_blob_len(out, frame.positions.len() * 4);
-    if frame.header.missing_count == 0 && frame.positions.iter().all(|v| v.is_finite()) {
-        for &v in &frame.positions {
-            wire::put_f32(out, v);
-        }
-        return Ok(());
+    let coords_at = out.len();
+    out.resize(coords_at + frame.positions.len() * 4, 0);
+    // a zip over pre-sized slices: no capacity checks in the loop, so it vectorises
+    for (c, v) in out[coords_at..].chunks_exact_mut(4).zip(&frame.positions) {
+        c.copy_from_slice(&v.to_be_bytes());
     }
-    for (m, xyz) in frame.positions.chunks_exact(3).enumerate() {
-        let missing = frame.is_missing(m);
-        if !missing && !xyz.iter().all(|v| v.is_finite()) {
-            out.truncate(start);
-            return Err(EncodeError::NonFinite { marker: m });
+    // missing markers go out as NaN whatever an edit wrote into them
+    if frame.header.missing_count > 0 {
+        for (k, &byte) in frame.missing.iter().enumerate().filter(|(_, &b)| b != 0) {
+            for bit in (0..8).filter(|bit| byte >> bit & 1 == 1) {
+                let at = coords_at + 12 * (8 * k + bit);
+                for c in out[at..at + 12].chunks_exact_mut(4) {
+                    c.copy_from_slice(&f32::NAN.to_be_bytes());
+                }
+            }
         }
-        for &v in xyz {
-            wire::put_f32(out, if missing { f32::NAN } else { v });
+    }
+    if !frame.positions.iter().all(|v| v.is_finite()) {
+        let bad = frame
+            .positions
+            .chunks_exact(3)
+            .enumerate()
+            .find(|(m, xyz)| !frame.is_missing(*m) && !xyz.iter().all(|v| v.is_finite()));
+        if let Some((marker, _)) = bad {
+            out.truncate(start);
+            return Err(EncodeError::NonFinite { marker });
         }
     }
     Ok(())

@@ -164,6 +164,13 @@ fn encoding_refuses_non_finite_present_markers_and_reuses_the_buffer() {
     f.set_missing(2, true);
     assert_eq!(encode_frame_into(&f, &mut out), Ok(frame_message_len(4)));
     assert_eq!(out.capacity(), cap);
+    // an edit that wrote into a missing marker does not leak onto the wire
+    f.positions_mut()[6] = 5.0;
+    encode_frame_into(&f, &mut out).expect("missing markers may hold anything");
+    let mut g = FrameBuf::new();
+    decode_frame_into(&out, &mut g).expect("valid");
+    assert!(g.is_missing(2) && g.positions()[6..9].iter().all(|v| v.is_nan()));
+    assert_eq!(g.positions()[..6], f.positions()[..6]);
     f.set_missing(2, false);
     f.positions_mut()[6..9].copy_from_slice(&[1.0, 2.0, 3.0]);
     assert_eq!(f.header().missing_count, 0);
