@@ -26,34 +26,15 @@ impl Contrast {
     /// Replaces each `y` by `g(y)` and returns the sum of `g'(y)`.
     pub(crate) fn apply(self, ys: &mut [f64]) -> f64 {
         match self {
-            Contrast::LogCosh => {
-                let mut acc = 0.0;
-                for y in ys.iter_mut() {
-                    let t = tanh_fast(*y);
-                    *y = t;
-                    acc += 1.0 - t * t;
-                }
-                acc
-            }
-            Contrast::Exp => {
-                let mut acc = 0.0;
-                for y in ys.iter_mut() {
-                    let v = *y;
-                    let e = exp_fast(-0.5 * v * v);
-                    *y = v * e;
-                    acc += (1.0 - v * v) * e;
-                }
-                acc
-            }
-            Contrast::Cube => {
-                let mut acc = 0.0;
-                for y in ys.iter_mut() {
-                    let v = *y;
-                    *y = v * v * v;
-                    acc += 3.0 * v * v;
-                }
-                acc
-            }
+            Contrast::LogCosh => map_sum(ys, |y| {
+                let t = tanh_fast(y);
+                (t, 1.0 - t * t)
+            }),
+            Contrast::Exp => map_sum(ys, |y| {
+                let e = exp_fast(-0.5 * y * y);
+                (y * e, (1.0 - y * y) * e)
+            }),
+            Contrast::Cube => map_sum(ys, |y| (y * y * y, 3.0 * y * y)),
         }
     }
 
@@ -99,6 +80,31 @@ impl Contrast {
         let mean = ys.iter().map(|&y| self.big_g(y)).sum::<f64>() / ys.len() as f64;
         (mean - gaussian).powi(2)
     }
+}
+
+/// Independent accumulators in [`map_sum`]: a single running sum is a sequential dependency
+/// that keeps the compiler from vectorising the loop (float addition does not reassociate).
+const LANES: usize = 8;
+
+/// Replaces each `y` by `f(y).0` and returns the sum of `f(y).1`, summed in [`LANES`] lanes
+/// (a fixed order, so the result is deterministic).
+#[inline(always)]
+fn map_sum(ys: &mut [f64], f: impl Fn(f64) -> (f64, f64)) -> f64 {
+    let mut acc = [0.0f64; LANES];
+    let mut chunks = ys.chunks_exact_mut(LANES);
+    for chunk in &mut chunks {
+        for (y, a) in chunk.iter_mut().zip(acc.iter_mut()) {
+            let (g, dg) = f(*y);
+            *y = g;
+            *a += dg;
+        }
+    }
+    for (y, a) in chunks.into_remainder().iter_mut().zip(acc.iter_mut()) {
+        let (g, dg) = f(*y);
+        *y = g;
+        *a += dg;
+    }
+    acc.iter().sum()
 }
 
 /// `e^x` for `x <= 0` (clamped at -700), branch-free so loops over it vectorise.
