@@ -11,6 +11,7 @@ pub mod csv;
 pub mod error;
 pub mod format;
 pub mod pacer;
+pub mod record;
 pub mod session;
 pub mod synth;
 pub mod take;

@@ -16,7 +16,7 @@ mod decode;
 mod error;
 mod layout;
 mod params;
-mod write;
+pub(crate) mod write;
 
 use std::io::Read;
 

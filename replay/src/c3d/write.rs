@@ -42,49 +42,117 @@ pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
     take.validate()?;
     let frames = take.n_frames();
     let range = FrameRange::new(take.first_frame, frames)?;
-    if take.n_markers() > MAX_MARKERS {
-        return Err(C3dLimitError::TooManyMarkers {
-            markers: take.n_markers(),
-            max: MAX_MARKERS,
-        }
-        .into());
+    check_labels(&take.labels)?;
+    let meta = Meta {
+        labels: &take.labels,
+        rate_hz: take.rate_hz,
+    };
+    let blocks = parameter_blocks(&meta, &range)?;
+    out.write_all(&head(&meta, &range, blocks))?;
+    let mut buf = Vec::with_capacity(meta.labels.len() * 16);
+    for f in 0..frames {
+        encode_frame(take.frame(f), take.frame_missing(f), &mut buf);
+        out.write_all(&buf)?;
     }
-    if let Some(l) = take.labels.iter().find(|l| l.len() > 255) {
-        return Err(C3dLimitError::LabelTooLong {
-            label: l.clone(),
-            len: l.len(),
-        }
-        .into());
-    }
-    // The data block depends on the parameter size, which depends on DATA_START's value only
-    // through its fixed width: build once with a placeholder, then again with the real value.
-    let probe = parameters(take, &range, 0);
-    let blocks = probe.len().div_ceil(BLOCK);
-    if blocks > MAX_PARAMETER_BLOCKS {
-        return Err(C3dLimitError::TooManyParameterBlocks { blocks }.into());
-    }
-    let data_block = 2 + blocks;
-    let mut params = parameters(take, &range, data_block as u16);
-    params.resize(blocks * BLOCK, 0);
-    params[2] = blocks as u8;
-    out.write_all(&header(take, &range, data_block as u16))?;
-    out.write_all(&params)?;
-    write_frames(take, out)?;
-    // Pad the last data block: some readers expect whole blocks.
-    let data_len = frames * take.n_markers() * 16;
-    out.write_all(&vec![0u8; (BLOCK - data_len % BLOCK) % BLOCK])?;
+    out.write_all(&vec![0u8; padding(frames, meta.labels.len())])?;
     Ok(())
 }
 
+/// What the header and parameters say about the points, besides the frame range.
+pub(crate) struct Meta<'a> {
+    /// Marker labels.
+    pub(crate) labels: &'a [String],
+    /// Frame rate, Hz.
+    pub(crate) rate_hz: f64,
+}
+
+/// Rejects labels C3D cannot hold: too many markers, a label over 255 bytes.
+pub(crate) fn check_labels(labels: &[String]) -> Result<(), C3dLimitError> {
+    if labels.len() > MAX_MARKERS {
+        return Err(C3dLimitError::TooManyMarkers {
+            markers: labels.len(),
+            max: MAX_MARKERS,
+        });
+    }
+    if let Some(l) = labels.iter().find(|l| l.len() > 255) {
+        return Err(C3dLimitError::LabelTooLong {
+            label: l.clone(),
+            len: l.len(),
+        });
+    }
+    Ok(())
+}
+
+/// Blocks the parameter section of `range` needs.
+///
+/// # Errors
+/// [`C3dLimitError::TooManyParameterBlocks`] past the one-byte block count.
+pub(crate) fn parameter_blocks(
+    meta: &Meta<'_>,
+    range: &FrameRange,
+) -> Result<usize, C3dLimitError> {
+    // The data block depends on the parameter size, which depends on DATA_START's value only
+    // through its fixed width: measure with a placeholder.
+    let blocks = parameters(meta, range, 0).len().div_ceil(BLOCK);
+    if blocks > MAX_PARAMETER_BLOCKS {
+        return Err(C3dLimitError::TooManyParameterBlocks { blocks });
+    }
+    Ok(blocks)
+}
+
+/// The header block and a parameter section padded to `blocks` blocks (at least what
+/// [`parameter_blocks`] reports for `range`): everything before the first frame. A recorder
+/// reserves the blocks of the longest range up front and rewrites this in place on finish.
+pub(crate) fn head(meta: &Meta<'_>, range: &FrameRange, blocks: usize) -> Vec<u8> {
+    let data_block = (2 + blocks) as u16;
+    let mut bytes = header(meta, range, data_block).to_vec();
+    let mut params = parameters(meta, range, data_block);
+    debug_assert!(
+        params.len() <= blocks * BLOCK,
+        "caller reserved enough blocks"
+    );
+    params.resize(blocks * BLOCK, 0);
+    params[2] = blocks as u8;
+    bytes.extend_from_slice(&params);
+    bytes
+}
+
+/// Zero bytes that pad the data of `frames` frames to whole blocks: some readers expect them.
+pub(crate) fn padding(frames: usize, markers: usize) -> usize {
+    let data_len = frames * markers * 16;
+    (BLOCK - data_len % BLOCK) % BLOCK
+}
+
+/// Encodes one frame (markers x 3 mm, one missing flag per marker) into `buf`, cleared first:
+/// x y z and a residual word per marker, a missing marker as xyz 0 with residual -1.
+pub(crate) fn encode_frame(xyz: &[f32], missing: &[bool], buf: &mut Vec<u8>) {
+    buf.clear();
+    for (p, &gone) in xyz.chunks_exact(3).zip(missing) {
+        if gone {
+            buf.extend_from_slice(&[0u8; 12]);
+            buf.extend_from_slice(&MISSING_WORD.to_le_bytes());
+        } else {
+            for v in p {
+                buf.extend_from_slice(&v.to_le_bytes());
+            }
+            buf.extend_from_slice(&PRESENT_WORD.to_le_bytes());
+        }
+    }
+}
+
 /// The frame numbers as the header and TRIAL store them.
-struct FrameRange {
+pub(crate) struct FrameRange {
     first: u32,
     last: u32,
     count: usize,
 }
 
 impl FrameRange {
-    fn new(first_frame: i64, frames: usize) -> Result<FrameRange, C3dLimitError> {
+    /// The range of `frames` frames numbered from `first_frame`.
+    ///
+    /// # Errors
+    /// No frames, a first frame outside 0..=65535, a last frame past 32 bits.
+    pub(crate) fn new(first_frame: i64, frames: usize) -> Result<FrameRange, C3dLimitError> {
         if frames == 0 {
             return Err(C3dLimitError::NoFrames);
         }
@@ -102,6 +170,12 @@ impl FrameRange {
         })
     }
 
+    /// A range long enough to need POINT:LONG_FRAMES: the parameter section a recorder
+    /// reserves, since it cannot know its length up front and longer ranges need no more room.
+    pub(crate) fn longest(first_frame: i64) -> Result<FrameRange, C3dLimitError> {
+        FrameRange::new(first_frame, usize::from(u16::MAX) + 1)
+    }
+
     /// The header's last frame, saturated at 65535.
     fn header_last(&self) -> u16 {
         u16::try_from(self.last).unwrap_or(u16::MAX)
@@ -117,12 +191,12 @@ impl FrameRange {
     }
 }
 
-fn header(take: &Take, range: &FrameRange, data_block: u16) -> [u8; BLOCK] {
+fn header(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> [u8; BLOCK] {
     let mut h = [0u8; BLOCK];
     h[0] = 2;
     h[1] = SIGNATURE;
     let mut put = |at: usize, b: &[u8]| h[at..at + b.len()].copy_from_slice(b);
-    put(2, &(take.n_markers() as u16).to_le_bytes());
+    put(2, &(meta.labels.len() as u16).to_le_bytes());
     put(4, &0u16.to_le_bytes()); // analog samples per frame
     put(6, &(range.first as u16).to_le_bytes());
     put(8, &range.header_last().to_le_bytes());
@@ -132,32 +206,8 @@ fn header(take: &Take, range: &FrameRange, data_block: u16) -> [u8; BLOCK] {
     // Analog samples per channel per frame: 1, matching ANALOG:RATE = POINT:RATE (py-c3d checks
     // that this word equals their ratio even with no analog channels).
     put(18, &1u16.to_le_bytes());
-    put(20, &(take.rate_hz as f32).to_le_bytes());
+    put(20, &(meta.rate_hz as f32).to_le_bytes());
     h
-}
-
-fn write_frames(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
-    let n = take.n_markers();
-    let mut buf = Vec::with_capacity(n * 16);
-    for f in 0..take.n_frames() {
-        buf.clear();
-        for m in 0..n {
-            match take.sample(f, m) {
-                Some(p) => {
-                    for v in p {
-                        buf.extend_from_slice(&v.to_le_bytes());
-                    }
-                    buf.extend_from_slice(&PRESENT_WORD.to_le_bytes());
-                }
-                None => {
-                    buf.extend_from_slice(&[0u8; 12]);
-                    buf.extend_from_slice(&MISSING_WORD.to_le_bytes());
-                }
-            }
-        }
-        out.write_all(&buf)?;
-    }
-    Ok(())
 }
 
 /// Group ids.
@@ -166,21 +216,21 @@ const ANALOG: i8 = 2;
 const FORCE_PLATFORM: i8 = 3;
 const TRIAL: i8 = 4;
 
-fn parameters(take: &Take, range: &FrameRange, data_block: u16) -> Vec<u8> {
+fn parameters(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> Vec<u8> {
     let mut w = Records::default();
     w.buf.extend_from_slice(&[1, SIGNATURE, 0, INTEL]);
     w.group(POINT, "POINT", "3-D point parameters");
-    w.int(POINT, "USED", &[take.n_markers() as u16]);
+    w.int(POINT, "USED", &[meta.labels.len() as u16]);
     w.int(POINT, "FRAMES", &[range.point_frames()]);
     if range.long() {
         w.float(POINT, "LONG_FRAMES", &[range.count as f32]);
     }
     w.int(POINT, "DATA_START", &[data_block]);
     w.float(POINT, "SCALE", &[SCALE]);
-    w.float(POINT, "RATE", &[take.rate_hz as f32]);
+    w.float(POINT, "RATE", &[meta.rate_hz as f32]);
     w.chars(POINT, "UNITS", &["mm".to_string()]);
-    let blanks = vec![String::new(); take.n_markers()];
-    for (k, chunk) in take.labels.chunks(LABELS_PER_PARAM).enumerate() {
+    let blanks = vec![String::new(); meta.labels.len()];
+    for (k, chunk) in meta.labels.chunks(LABELS_PER_PARAM).enumerate() {
         let suffix = if k == 0 {
             String::new()
         } else {
@@ -192,7 +242,7 @@ fn parameters(take: &Take, range: &FrameRange, data_block: u16) -> Vec<u8> {
     }
     w.group(ANALOG, "ANALOG", "analog data parameters");
     w.int(ANALOG, "USED", &[0]);
-    w.float(ANALOG, "RATE", &[take.rate_hz as f32]);
+    w.float(ANALOG, "RATE", &[meta.rate_hz as f32]);
     w.float(ANALOG, "GEN_SCALE", &[1.0]);
     w.chars(ANALOG, "FORMAT", &["SIGNED".to_string()]);
     w.int(ANALOG, "BITS", &[16]);
@@ -300,7 +350,11 @@ mod tests {
         let mut take = Take::new(vec!["a".into(), "b".into()], 50.0, 1);
         take.push_frame(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0], &[false, true]);
         let range = FrameRange::new(1, 1).expect("one frame");
-        let mut params = parameters(&take, &range, 3);
+        let meta = Meta {
+            labels: &take.labels,
+            rate_hz: take.rate_hz,
+        };
+        let mut params = parameters(&meta, &range, 3);
         // Append an EVENT group to the finished section: patch the last record's zero offset.
         let last = params.len() - 1 - 2; // the TRIAL:ACTUAL_END_FIELD offset word
         let mut w = Records {
@@ -312,9 +366,11 @@ mod tests {
         let mut params = w.finish();
         params.resize(BLOCK, 0);
         params[2] = 1;
-        let mut file = header(&take, &range, 3).to_vec();
+        let mut file = header(&meta, &range, 3).to_vec();
         file.extend_from_slice(&params);
-        write_frames(&take, &mut file).expect("writes to a Vec");
+        let mut frame = Vec::new();
+        encode_frame(take.frame(0), take.frame_missing(0), &mut frame);
+        file.extend_from_slice(&frame);
         file.resize(3 * BLOCK, 0);
         let (back, info) = crate::c3d::read_with_info(&file).expect("fallback reads it");
         assert_eq!(info.decoder, crate::c3d::Decoder::Fallback);
