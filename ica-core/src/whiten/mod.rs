@@ -117,24 +117,8 @@ pub fn whiten<T: Copy + Into<f64>>(
             needed,
         });
     }
-    let mut mean = stats::mean(data, &sel);
-    let var = stats::variances(data, &sel, &mean);
-    let max_var = var.iter().copied().fold(0.0f64, f64::max);
-    if max_var <= 0.0 {
-        return Err(FitError::NoVariance {
-            channels: data.channels(),
-        });
-    }
-    let (live, dead): (Vec<usize>, Vec<usize>) = (0..data.channels()).partition(|&c| {
-        !sel.always_missing[c] && var[c] > DEAD_CHANNEL_RELATIVE_VARIANCE * max_var
-    });
-    // A constant channel keeps its constant as mean (so the reconstruction is right); one never
-    // seen has mean 0 already.
-    for &c in &dead {
-        if sel.always_missing[c] {
-            mean[c] = 0.0;
-        }
-    }
+    let mean = stats::mean(data, &sel);
+    let (live, dead) = classify_channels(data, &sel, &mean)?;
     let cov = stats::covariance(data, &sel.used_frames, &live, &mean);
     let (eigenvalues, axes) = sorted_eigen(cov);
     let lmax = eigenvalues.first().copied().unwrap_or(0.0);
@@ -163,6 +147,26 @@ pub fn whiten<T: Copy + Into<f64>>(
         used_frames: sel.used_frames,
         frames_total: data.frames(),
     })
+}
+
+/// Splits channels into live ones and dead ones (missing everywhere, or variance at most
+/// [`DEAD_CHANNEL_RELATIVE_VARIANCE`] of the largest). A constant channel keeps its constant as
+/// mean, so the reconstruction `mean + M u` is right for it; one never seen has mean 0.
+fn classify_channels<T: Copy + Into<f64>>(
+    data: &FitData<'_, T>,
+    sel: &stats::Selection,
+    mean: &[f64],
+) -> Result<(Vec<usize>, Vec<usize>), FitError> {
+    let var = stats::variances(data, sel, mean);
+    let max_var = var.iter().copied().fold(0.0f64, f64::max);
+    if max_var <= 0.0 {
+        return Err(FitError::NoVariance {
+            channels: data.channels(),
+        });
+    }
+    Ok((0..data.channels()).partition(|&c| {
+        !sel.always_missing[c] && var[c] > DEAD_CHANNEL_RELATIVE_VARIANCE * max_var
+    }))
 }
 
 /// Eigen-decomposes a symmetric matrix; returns eigenvalues (clamped at 0) largest first and the
