@@ -169,3 +169,25 @@ fn report_describes_the_run() {
     assert!(r.eigenvalues.windows(2).all(|w| w[0] >= w[1]));
     assert!(r.variance_kept > 0.9 && r.variance_kept <= 1.0);
 }
+
+#[test]
+fn one_and_two_components_fit_through_the_small_matrix_paths() {
+    for k in [1, 2] {
+        for algorithm in [Algorithm::Symmetric, Algorithm::Deflation] {
+            let params = FastIcaParams::default().algorithm(algorithm).restarts(2);
+            let (mix, out) = fit_mixture(3000, k, 21, params);
+            assert_eq!(out.mixing.shape(), (60, k));
+            assert!(out
+                .mixing
+                .iter()
+                .chain(out.unmixing.iter())
+                .all(|v| v.is_finite()));
+            assert!(
+                out.report.restarts.iter().all(|r| r.converged),
+                "k={k} {algorithm:?}"
+            );
+            let ai = amari_index(&(&out.unmixing * &mix.mixing)).expect("square");
+            assert!(ai < 0.1, "k={k} {algorithm:?}: amari index {ai}");
+        }
+    }
+}
