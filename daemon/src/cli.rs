@@ -134,6 +134,25 @@ pub struct TrainArgs {
     /// Convergence tolerance.
     #[arg(long, default_value_t = ica_core::fit::DEFAULT_TOL)]
     pub tol: f64,
+    /// Model rate in Hz; takes at other rates are resampled (default: the first take's rate).
+    #[arg(long)]
+    pub rate: Option<f64>,
+    /// Leave out markers missing in more than this share of the frames.
+    #[arg(long, default_value_t = 0.5)]
+    pub max_missing: f64,
+    /// Glitch speed limit: auto, off, or mm/s. Faster moves are treated as missing.
+    #[arg(long, default_value = "auto")]
+    pub max_speed: String,
+    /// Rigid head markers: auto, none, or comma-separated labels (default: the regions file's
+    /// head_reference, else auto).
+    #[arg(long)]
+    pub head_reference: Option<String>,
+    /// Regions file (default: regions.toml beside the manifest, if any).
+    #[arg(long)]
+    pub regions: Option<PathBuf>,
+    /// Do not learn per-marker plausible regions (which drop swapped or drifting labels).
+    #[arg(long)]
+    pub no_bounds: bool,
 }
 
 /// `emoshift project`.

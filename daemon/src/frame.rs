@@ -1,22 +1,25 @@
 //! The per-frame path shared by the offline commands and the live daemon, so that `emoshift
 //! edit` and `emoshift serve` produce the same markers for the same settings:
 //!
-//! 1. glitch check: a sample that moved faster than the model's `max_speed_mm_s` since the last
-//!    accepted sample of that marker (a marker swap or spike) is treated as missing;
-//! 2. head stabilisation: the rigid pose from the model's reference markers is removed;
+//! 1. head stabilisation: the rigid pose from the model's reference markers is removed;
+//! 2. glitch checks, in head coordinates: a sample outside its marker's plausible ball (the
+//!    model's `bounds`: labels that swap or drift slowly) or one that moved faster than the
+//!    model's `max_speed_mm_s` since that marker's last accepted sample (spikes) is treated as
+//!    missing;
 //! 3. projection, masked where markers are missing;
 //! 4. (the caller edits the components);
 //! 5. resynthesis, and the captured head pose put back.
 //!
 //! Every buffer is allocated in [`FrameProcessor::new`]; the frame calls do not allocate.
 
-use ica_core::model::IcaModel;
+use ica_core::model::{CaptureSettings, IcaModel};
 use ica_core::project::{FrameError, FrameStatus, Projector};
 use ica_core::stabilise::{self, Pose, Stabiliser};
 
-/// A glitching marker is re-accepted after this many rejected frames in a row, so a marker
-/// that really moved (or was relabelled for good) is not lost forever.
-pub const GLITCH_RELEASE_FRAMES: u32 = 12;
+/// A glitching marker is believed again after this long (seconds) of rejected samples in a
+/// row, so a marker that really moved (or was relabelled for good) is not lost forever. Long
+/// enough for the swaps seen in real captures (Facial-Sing: 23 frames at 100 Hz).
+pub const GLITCH_RELEASE_S: f64 = 0.5;
 
 /// What preparing and projecting one frame found.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -33,46 +36,196 @@ pub struct Prepared {
     pub glitches: usize,
 }
 
-/// Per-frame processor for one stream or take. See the module docs for the steps.
+/// Steps 1–2 alone (glitch check and head stabilisation): what training needs before a model
+/// exists, and what [`FrameProcessor`] runs before projecting.
 #[derive(Debug, Clone)]
-pub struct FrameProcessor {
-    projector: Projector,
+pub struct FramePrep {
     stabiliser: Option<Stabiliser>,
-    /// Largest accepted move per frame (mm), from the model's speed limit and rate.
+    /// Largest accepted move per frame (mm), from the speed limit and rate.
     max_step_mm: Option<f32>,
+    /// Frames a glitching marker stays rejected before it is believed again.
+    release_frames: u32,
     last: Vec<f32>,
     last_known: Vec<bool>,
     rejected_run: Vec<u32>,
+    /// Frames a marker was absent (not rejected) since its last accepted sample.
+    unseen_run: Vec<u32>,
     missing: Vec<bool>,
     head: Vec<f32>,
-    scratch: Vec<f32>,
+    /// Per-marker centre (x y z) and squared radius of the plausible region, head coordinates.
+    bounds: Option<(Vec<f32>, Vec<f32>)>,
 }
 
-impl FrameProcessor {
-    /// Builds the processor and all its buffers from a model.
-    pub fn new(model: &IcaModel) -> FrameProcessor {
-        let markers = model.markers();
-        let capture = model.capture();
+/// A prepared frame: positions (head coordinates when stabilised) and the missing mask
+/// including glitches, borrowed from the [`FramePrep`].
+#[derive(Debug)]
+pub struct PreparedFrame<'a> {
+    /// Positions, markers x 3 (mm).
+    pub xyz: &'a [f32],
+    /// Missing flags after the glitch check.
+    pub missing: &'a [bool],
+    /// What preparing found (pose, residual, glitches); `status` is left default.
+    pub info: Prepared,
+}
+
+impl FramePrep {
+    /// Preparation for `markers` markers at `rate_hz` with the given settings.
+    pub fn new(markers: usize, rate_hz: f64, capture: &CaptureSettings) -> FramePrep {
         let stabiliser = capture
             .head
             .clone()
             .and_then(|head| Stabiliser::new(head).ok());
-        FrameProcessor {
-            projector: Projector::new(model),
+        FramePrep {
             stabiliser,
-            max_step_mm: capture.max_speed_mm_s.map(|v| (v / model.rate_hz()) as f32),
+            max_step_mm: capture.max_speed_mm_s.map(|v| (v / rate_hz) as f32),
+            release_frames: ((GLITCH_RELEASE_S * rate_hz).ceil() as u32).max(1),
             last: vec![0.0; markers * 3],
             last_known: vec![false; markers],
             rejected_run: vec![0; markers],
+            unseen_run: vec![0; markers],
             missing: vec![false; markers],
             head: vec![0.0; markers * 3],
-            scratch: vec![0.0; markers * 3],
+            bounds: capture.bounds.as_ref().map(|b| {
+                let centre = b.centre.iter().flatten().map(|&v| v as f32).collect();
+                let r2 = b.radius_mm.iter().map(|&r| (r * r) as f32).collect();
+                (centre, r2)
+            }),
         }
     }
 
     /// Markers per frame.
     pub fn markers(&self) -> usize {
         self.missing.len()
+    }
+
+    /// Forgets the stream's history (glitch reference, held pose).
+    pub fn reset(&mut self) {
+        self.last_known.fill(false);
+        self.rejected_run.fill(0);
+        self.unseen_run.fill(0);
+        if let Some(s) = &mut self.stabiliser {
+            s.reset();
+        }
+    }
+
+    /// Glitch check and stabilisation of one frame in model marker order.
+    ///
+    /// # Errors
+    /// [`FrameError::Length`] when a buffer does not match the marker count.
+    pub fn prepare<'a>(
+        &'a mut self,
+        xyz: &'a [f32],
+        missing: &[bool],
+    ) -> Result<PreparedFrame<'a>, FrameError> {
+        let n = self.markers();
+        if xyz.len() != n * 3 || missing.len() != n {
+            return Err(FrameError::Length {
+                what: "frame",
+                expected: n * 3,
+                got: xyz.len(),
+            });
+        }
+        for (m, gone) in self.missing.iter_mut().enumerate() {
+            *gone = missing[m] || !xyz[m * 3..m * 3 + 3].iter().all(|v| v.is_finite());
+        }
+        let mut info = Prepared::default();
+        let stabilised = match &mut self.stabiliser {
+            Some(st) => {
+                let est = st.estimate(xyz, &self.missing);
+                stabilise::to_head_into(&est.pose, xyz, &self.missing, &mut self.head);
+                info.pose = Some(est.pose);
+                info.residual_mm = est.residual_mm;
+                info.pose_held = est.held;
+                true
+            }
+            None => {
+                self.head.copy_from_slice(xyz);
+                false
+            }
+        };
+        info.glitches = self.check_bounds() + self.check_speed();
+        Ok(PreparedFrame {
+            xyz: if stabilised { &self.head } else { xyz },
+            missing: &self.missing,
+            info,
+        })
+    }
+
+    /// Marks samples outside their marker's plausible ball (head coordinates) as missing.
+    fn check_bounds(&mut self) -> usize {
+        let Some((centre, r2)) = &self.bounds else {
+            return 0;
+        };
+        let mut glitches = 0;
+        for (m, gone) in self.missing.iter_mut().enumerate() {
+            if *gone {
+                continue;
+            }
+            let d2: f32 = (0..3)
+                .map(|a| (self.head[m * 3 + a] - centre[m * 3 + a]).powi(2))
+                .sum();
+            if d2 > r2[m] {
+                *gone = true;
+                glitches += 1;
+            }
+        }
+        glitches
+    }
+
+    /// Marks samples that moved faster than the speed limit since their marker's last accepted
+    /// sample (head coordinates, so head motion does not count) as missing.
+    fn check_speed(&mut self) -> usize {
+        let mut glitches = 0;
+        for m in 0..self.missing.len() {
+            if self.missing[m] {
+                self.unseen_run[m] = self.unseen_run[m].saturating_add(1);
+                continue;
+            }
+            let p = &self.head[m * 3..m * 3 + 3];
+            if let (Some(step), true) = (self.max_step_mm, self.last_known[m]) {
+                let q = &self.last[m * 3..m * 3 + 3];
+                let d2: f32 = (0..3).map(|a| (p[a] - q[a]) * (p[a] - q[a])).sum();
+                // The allowance grows with the frames the marker was unseen, not with rejected
+                // frames: a swapped marker stays far from its last good position, and must not
+                // be believed just because time passed.
+                let allowed = step * (1 + self.unseen_run[m]) as f32;
+                if d2 > allowed * allowed && self.rejected_run[m] < self.release_frames {
+                    self.missing[m] = true;
+                    self.rejected_run[m] += 1;
+                    glitches += 1;
+                    continue;
+                }
+            }
+            self.last[m * 3..m * 3 + 3].copy_from_slice(p);
+            self.last_known[m] = true;
+            self.rejected_run[m] = 0;
+            self.unseen_run[m] = 0;
+        }
+        glitches
+    }
+}
+
+/// Per-frame processor for one stream or take. See the module docs for the steps.
+#[derive(Debug, Clone)]
+pub struct FrameProcessor {
+    prep: FramePrep,
+    projector: Projector,
+    scratch: Vec<f32>,
+}
+
+impl FrameProcessor {
+    /// Builds the processor and all its buffers from a model.
+    pub fn new(model: &IcaModel) -> FrameProcessor {
+        FrameProcessor {
+            prep: FramePrep::new(model.markers(), model.rate_hz(), model.capture()),
+            projector: Projector::new(model),
+            scratch: vec![0.0; model.channels()],
+        }
+    }
+
+    /// Markers per frame.
+    pub fn markers(&self) -> usize {
+        self.prep.markers()
     }
 
     /// Components per frame.
@@ -82,12 +235,8 @@ impl FrameProcessor {
 
     /// Forgets the stream's history (glitch reference, held pose, held components).
     pub fn reset(&mut self) {
-        self.last_known.fill(false);
-        self.rejected_run.fill(0);
+        self.prep.reset();
         self.projector.reset();
-        if let Some(s) = &mut self.stabiliser {
-            s.reset();
-        }
     }
 
     /// Steps 1–3: glitch check, stabilisation and projection of a frame in model marker order.
@@ -101,34 +250,12 @@ impl FrameProcessor {
         missing: &[bool],
         u: &mut [f32],
     ) -> Result<Prepared, FrameError> {
-        let n = self.markers();
-        if xyz.len() != n * 3 || missing.len() != n {
-            return Err(FrameError::Length {
-                what: "frame",
-                expected: n * 3,
-                got: xyz.len(),
-            });
-        }
-        let glitches = self.check_glitches(xyz, missing);
-        let mut prepared = Prepared {
-            glitches,
-            ..Prepared::default()
-        };
-        let input: &[f32] = match &mut self.stabiliser {
-            Some(st) => {
-                let est = st.estimate(xyz, &self.missing);
-                stabilise::to_head_into(&est.pose, xyz, &self.missing, &mut self.head);
-                prepared.pose = Some(est.pose);
-                prepared.residual_mm = est.residual_mm;
-                prepared.pose_held = est.held;
-                &self.head
-            }
-            None => xyz,
-        };
-        prepared.status = self
+        let frame = self.prep.prepare(xyz, missing)?;
+        let mut info = frame.info;
+        info.status = self
             .projector
-            .project_masked_into(input, Some(&self.missing), u)?;
-        Ok(prepared)
+            .project_masked_into(frame.xyz, Some(frame.missing), u)?;
+        Ok(info)
     }
 
     /// Step 5: resynthesise (edited) components and put the head pose back into `out`.
@@ -149,34 +276,5 @@ impl FrameProcessor {
             }
             None => self.projector.resynth_into(u, out),
         }
-    }
-
-    /// Marks missing samples and glitches in `self.missing`; returns the glitch count.
-    fn check_glitches(&mut self, xyz: &[f32], missing: &[bool]) -> usize {
-        let mut glitches = 0;
-        for m in 0..missing.len() {
-            let p = &xyz[m * 3..m * 3 + 3];
-            let gone = missing[m] || !p.iter().all(|v| v.is_finite());
-            self.missing[m] = gone;
-            if gone {
-                continue;
-            }
-            if let (Some(step), true) = (self.max_step_mm, self.last_known[m]) {
-                let q = &self.last[m * 3..m * 3 + 3];
-                let d2: f32 = (0..3).map(|a| (p[a] - q[a]) * (p[a] - q[a])).sum();
-                // The allowance grows with the frames since the last accepted sample.
-                let allowed = step * (1 + self.rejected_run[m]) as f32;
-                if d2 > allowed * allowed && self.rejected_run[m] < GLITCH_RELEASE_FRAMES {
-                    self.missing[m] = true;
-                    self.rejected_run[m] += 1;
-                    glitches += 1;
-                    continue;
-                }
-            }
-            self.last[m * 3..m * 3 + 3].copy_from_slice(p);
-            self.last_known[m] = true;
-            self.rejected_run[m] = 0;
-        }
-        glitches
     }
 }

@@ -10,6 +10,7 @@ pub mod c3d;
 pub mod csv;
 pub mod error;
 pub mod format;
+mod resample;
 pub mod pacer;
 pub mod record;
 pub mod session;

@@ -87,6 +87,20 @@ pub struct CaptureSettings {
     /// as missing. `None` disables the check.
     #[serde(default)]
     pub max_speed_mm_s: Option<f64>,
+    /// Where each marker may be, in head coordinates: a sample farther than `radius_mm` from
+    /// `centre` is a glitch (a swapped or drifting label) and is treated as missing. `None`
+    /// disables the check.
+    #[serde(default)]
+    pub bounds: Option<MarkerBounds>,
+}
+
+/// Per-marker plausible region: a ball around a centre, in the coordinates the model works in.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MarkerBounds {
+    /// Centre of each marker (mm), one per model marker.
+    pub centre: Vec<[f64; 3]>,
+    /// Radius of each marker's ball (mm).
+    pub radius_mm: Vec<f64>,
 }
 
 impl CaptureSettings {
@@ -432,6 +446,19 @@ pub(crate) fn check_capture(capture: &CaptureSettings, markers: usize) -> Result
         }
         if head.template.iter().flatten().any(|v| !v.is_finite()) {
             return bad("head reference template is not finite".into());
+        }
+    }
+    if let Some(b) = &capture.bounds {
+        if b.centre.len() != markers || b.radius_mm.len() != markers {
+            return bad(format!(
+                "marker bounds hold {} centres and {} radii for {markers} markers",
+                b.centre.len(),
+                b.radius_mm.len()
+            ));
+        }
+        let finite = b.centre.iter().flatten().all(|v| v.is_finite());
+        if !finite || b.radius_mm.iter().any(|r| !(r.is_finite() && *r > 0.0)) {
+            return bad("marker bounds must be finite with positive radii".into());
         }
     }
     if let Some(v) = capture.max_speed_mm_s {

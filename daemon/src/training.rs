@@ -1,0 +1,383 @@
+//! Preparing real captures for training (issue "real captures"): one rate, markers that are
+//! mostly there, glitches removed, head motion taken out.
+//!
+//! 1. **Rates**: every take is resampled (linear) to the model rate, and the report says so.
+//! 2. **Markers**: the first take's labels, minus markers missing in more than
+//!    [`PrepOptions::max_missing_share`] of all frames (like Facial-Sing's `Unlabeled1`).
+//! 3. **Glitches**: a marker moving faster than the speed limit since its last accepted sample
+//!    (a swap or a spike) is treated as missing. The limit is given, or derived from the data:
+//!    [`AUTO_SPEED_FACTOR`] × the 99.9th percentile of marker speeds, at least
+//!    [`MIN_AUTO_SPEED_MM_S`].
+//! 4. **Head**: rigid reference markers (given, from the regions file, or chosen automatically
+//!    as the set whose pairwise distances vary least) give each frame's pose; the face is
+//!    modelled in head coordinates. The stabilisation residual is reported.
+//!
+//! The same [`FramePrep`] then runs in `project`, `edit` and the daemon, from the settings
+//! stored in the model.
+
+use anyhow::{bail, Result};
+use ica_core::model::{CaptureSettings, MarkerBounds};
+use ica_core::stabilise::{choose_reference, Stabiliser};
+use replay::session::Regions;
+
+use crate::frame::FramePrep;
+use crate::layout::LabelMap;
+use crate::offline::{self, LoadedTake, ModelFrames};
+
+/// Multiple of the 99.9th percentile speed that marks a glitch when the limit is automatic.
+pub const AUTO_SPEED_FACTOR: f64 = 4.0;
+/// Floor of the automatic speed limit (mm/s): faces do not move faster than this in a frame.
+pub const MIN_AUTO_SPEED_MM_S: f64 = 500.0;
+/// Reference markers chosen automatically.
+pub const AUTO_REFERENCE_COUNT: usize = 4;
+
+/// How the head reference is chosen.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum HeadChoice {
+    /// No stabilisation.
+    None,
+    /// The markers whose pairwise distances vary least.
+    Auto,
+    /// These labels or glob patterns (as in a regions file).
+    Labels(Vec<String>),
+}
+
+/// The glitch speed limit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SpeedLimit {
+    /// No glitch check.
+    Off,
+    /// Derived from the data.
+    Auto,
+    /// This many mm/s.
+    MmPerS(f64),
+}
+
+/// Options of [`prepare`].
+#[derive(Debug, Clone)]
+pub struct PrepOptions {
+    /// Model rate; `None` takes the first take's.
+    pub rate_hz: Option<f64>,
+    /// Markers missing in more than this share of frames are left out.
+    pub max_missing_share: f64,
+    /// Glitch speed limit.
+    pub speed: SpeedLimit,
+    /// Head reference.
+    pub head: HeadChoice,
+    /// Learn per-marker plausible regions and treat samples outside them as glitches.
+    pub bounds: bool,
+}
+
+/// Training data in model order, head coordinates, with what preparing found.
+#[derive(Debug, Clone)]
+pub struct PreparedData {
+    /// Marker labels of the model.
+    pub labels: Vec<String>,
+    /// Model rate.
+    pub rate_hz: f64,
+    /// Frames x channels, head coordinates when stabilised.
+    pub samples: Vec<f32>,
+    /// Frames x channels missing flags (glitches included).
+    pub missing: Vec<bool>,
+    /// Settings to store in the model.
+    pub capture: CaptureSettings,
+    /// Markers left out, with the share of frames they were missing in.
+    pub excluded: Vec<(String, f64)>,
+    /// Takes resampled: file, from rate, to rate.
+    pub resampled: Vec<(String, f64, f64)>,
+    /// Samples dropped as glitches.
+    pub glitches: usize,
+    /// Glitches per marker (model order).
+    pub glitches_per_marker: Vec<usize>,
+    /// Per-frame stabilisation residual (mm), frames where the pose was estimated.
+    pub residuals_mm: Vec<f64>,
+    /// Reference marker labels (empty without stabilisation).
+    pub reference: Vec<String>,
+}
+
+impl PreparedData {
+    /// Median and 95th percentile of the stabilisation residual (mm).
+    pub fn residual_summary(&self) -> Option<(f64, f64)> {
+        let mut r: Vec<f64> = self
+            .residuals_mm
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect();
+        if r.is_empty() {
+            return None;
+        }
+        r.sort_by(f64::total_cmp);
+        let at = |q: f64| r[((r.len() - 1) as f64 * q).round() as usize];
+        Some((at(0.5), at(0.95)))
+    }
+}
+
+/// Prepares loaded takes for training. See the module docs.
+///
+/// # Errors
+/// No marker left, unknown reference labels, too few reference markers, or no take shares a
+/// marker with the first.
+pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedData> {
+    let rate_hz = options.rate_hz.unwrap_or(takes[0].take.rate_hz);
+    let mut resampled = Vec::new();
+    let takes: Vec<replay::Take> = takes
+        .iter()
+        .map(|t| {
+            if (t.take.rate_hz - rate_hz).abs() > 1e-6 * rate_hz {
+                resampled.push((t.path.display().to_string(), t.take.rate_hz, rate_hz));
+                t.take.resampled(rate_hz)
+            } else {
+                t.take.clone()
+            }
+        })
+        .collect();
+    let (labels, excluded) = kept_markers(&takes, options.max_missing_share)?;
+    let frames: Vec<ModelFrames> = takes
+        .iter()
+        .map(|t| {
+            Ok(offline::to_model_order(
+                t,
+                &LabelMap::new(&labels, &t.labels)?,
+            ))
+        })
+        .collect::<Result<_>>()?;
+    let n = labels.len();
+    // 1. The head: template from the raw frames (its Procrustes mean shrugs off rare glitches).
+    let raw_missing: Vec<bool> = frames
+        .iter()
+        .flat_map(|f| f.missing.iter().copied())
+        .collect();
+    let raw_xyz: Vec<f32> = frames.iter().flat_map(|f| f.xyz.iter().copied()).collect();
+    let reference = reference_markers(&options.head, &labels, &raw_xyz, &raw_missing)?;
+    let head = match reference.len() {
+        0 => None,
+        _ => Some(
+            Stabiliser::fit(&raw_xyz, &raw_missing, n, reference.clone())?
+                .reference()
+                .clone(),
+        ),
+    };
+    let mut capture = CaptureSettings {
+        head,
+        max_speed_mm_s: None,
+        bounds: None,
+    };
+    // 2. Speeds and plausible regions measured in head coordinates, then applied.
+    let (head_xyz, head_missing, _, _) = run_prep(&frames, n, rate_hz, &capture)?;
+    capture.max_speed_mm_s = match options.speed {
+        SpeedLimit::Off => None,
+        SpeedLimit::MmPerS(v) => Some(v),
+        SpeedLimit::Auto => auto_speed(&head_xyz, &head_missing, &frames, n, rate_hz),
+    };
+    if options.bounds {
+        capture.bounds = Some(marker_bounds(&head_xyz, &head_missing, n));
+    }
+    let (samples, marker_missing, glitches, residuals_mm) =
+        run_prep(&frames, n, rate_hz, &capture)?;
+    let per_marker = glitches_per_marker(&frames, &marker_missing, n);
+    Ok(PreparedData {
+        glitches_per_marker: per_marker,
+        reference: reference.iter().map(|&i| labels[i].clone()).collect(),
+        labels,
+        rate_hz,
+        samples,
+        missing: marker_missing.iter().flat_map(|&m| [m, m, m]).collect(),
+        capture,
+        excluded,
+        resampled,
+        glitches,
+        residuals_mm,
+    })
+}
+
+type PrepRun = (Vec<f32>, Vec<bool>, usize, Vec<f64>);
+
+/// Samples flagged missing after preparation but present in the input, per marker.
+fn glitches_per_marker(frames: &[ModelFrames], prepared_missing: &[bool], n: usize) -> Vec<usize> {
+    let input = frames.iter().flat_map(|f| f.missing.iter().copied());
+    let mut counts = vec![0; n];
+    for (i, (before, after)) in input.zip(prepared_missing).enumerate() {
+        if !before && *after {
+            counts[i % n] += 1;
+        }
+    }
+    counts
+}
+
+/// Runs every take through a fresh [`FramePrep`]: positions, per-marker mask, glitches,
+/// residuals.
+fn run_prep(
+    frames: &[ModelFrames],
+    n: usize,
+    rate_hz: f64,
+    capture: &CaptureSettings,
+) -> Result<PrepRun> {
+    let total: usize = frames.iter().map(ModelFrames::frames).sum();
+    let mut xyz = Vec::with_capacity(total * n * 3);
+    let mut missing = Vec::with_capacity(total * n);
+    let mut glitches = 0;
+    let mut residuals = Vec::new();
+    for take in frames {
+        let mut prep = FramePrep::new(n, rate_hz, capture);
+        for f in 0..take.frames() {
+            let (p, m) = take.frame(f);
+            let out = prep.prepare(p, m)?;
+            xyz.extend_from_slice(out.xyz);
+            missing.extend_from_slice(out.missing);
+            glitches += out.info.glitches;
+            if out.info.pose.is_some() && !out.info.pose_held {
+                residuals.push(out.info.residual_mm);
+            }
+        }
+    }
+    Ok((xyz, missing, glitches, residuals))
+}
+
+/// The first take's labels minus the markers missing too often over all takes.
+fn kept_markers(
+    takes: &[replay::Take],
+    max_share: f64,
+) -> Result<(Vec<String>, Vec<(String, f64)>)> {
+    let first = &takes[0].labels;
+    let mut missing = vec![0usize; first.len()];
+    let mut frames = 0usize;
+    for t in takes {
+        let map = LabelMap::new(first, &t.labels)?;
+        let counts = t.missing_per_marker();
+        for (i, src) in map.model_to_take.iter().enumerate() {
+            missing[i] += match src {
+                Some(j) => counts[*j],
+                None => t.n_frames(),
+            };
+        }
+        frames += t.n_frames();
+    }
+    let mut kept = Vec::new();
+    let mut excluded = Vec::new();
+    for (label, &gone) in first.iter().zip(&missing) {
+        let share = gone as f64 / frames.max(1) as f64;
+        if share > max_share {
+            excluded.push((label.clone(), share));
+        } else {
+            kept.push(label.clone());
+        }
+    }
+    if kept.is_empty() {
+        bail!(
+            "every marker is missing in more than {:.0} % of the frames",
+            100.0 * max_share
+        );
+    }
+    Ok((kept, excluded))
+}
+
+/// Radius of a marker's plausible ball: this multiple of the 99th percentile of its distance
+/// from its median position…
+pub const BOUNDS_FACTOR: f64 = 2.0;
+/// …but never below this (mm), so a nearly still marker keeps room for real motion.
+pub const MIN_BOUNDS_MM: f64 = 15.0;
+
+/// Per-marker ball: centre at the median position, radius [`BOUNDS_FACTOR`] × the 99th
+/// percentile distance from it, at least [`MIN_BOUNDS_MM`]. Medians and percentiles ignore the
+/// rare glitches they are meant to catch.
+fn marker_bounds(xyz: &[f32], missing: &[bool], n: usize) -> MarkerBounds {
+    let frames = missing.len() / n.max(1);
+    let mut centre = Vec::with_capacity(n);
+    let mut radius_mm = Vec::with_capacity(n);
+    let mut values = Vec::with_capacity(frames);
+    for m in 0..n {
+        let present: Vec<usize> = (0..frames).filter(|&f| !missing[f * n + m]).collect();
+        let mut c = [0.0f64; 3];
+        for (a, slot) in c.iter_mut().enumerate() {
+            values.clear();
+            values.extend(present.iter().map(|&f| f64::from(xyz[(f * n + m) * 3 + a])));
+            *slot = quantile(&mut values, 0.5).unwrap_or(0.0);
+        }
+        values.clear();
+        values.extend(present.iter().map(|&f| {
+            (0..3)
+                .map(|a| (f64::from(xyz[(f * n + m) * 3 + a]) - c[a]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        }));
+        let r = quantile(&mut values, 0.99).unwrap_or(0.0) * BOUNDS_FACTOR;
+        centre.push(c);
+        radius_mm.push(r.max(MIN_BOUNDS_MM));
+    }
+    MarkerBounds { centre, radius_mm }
+}
+
+fn quantile(values: &mut [f64], q: f64) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    let k = ((values.len() - 1) as f64 * q).round() as usize;
+    let (_, v, _) = values.select_nth_unstable_by(k, f64::total_cmp);
+    Some(*v)
+}
+
+/// [`AUTO_SPEED_FACTOR`] × the 99.9th percentile of per-frame marker speeds (mm/s), over
+/// frames concatenated take after take (`frames` gives the take boundaries).
+fn auto_speed(
+    xyz: &[f32],
+    missing: &[bool],
+    frames: &[ModelFrames],
+    n: usize,
+    rate_hz: f64,
+) -> Option<f64> {
+    let mut speeds = Vec::new();
+    let mut start = 0;
+    for take in frames {
+        for f in start + 1..start + take.frames() {
+            for m in 0..n {
+                if !missing[(f - 1) * n + m] && !missing[f * n + m] {
+                    let d2: f32 = (0..3)
+                        .map(|k| {
+                            (xyz[(f * n + m) * 3 + k] - xyz[((f - 1) * n + m) * 3 + k]).powi(2)
+                        })
+                        .sum();
+                    speeds.push(f64::from(d2.sqrt()) * rate_hz);
+                }
+            }
+        }
+        start += take.frames();
+    }
+    Some((quantile(&mut speeds, 0.999)? * AUTO_SPEED_FACTOR).max(MIN_AUTO_SPEED_MM_S))
+}
+
+fn reference_markers(
+    choice: &HeadChoice,
+    labels: &[String],
+    xyz: &[f32],
+    missing: &[bool],
+) -> Result<Vec<usize>> {
+    match choice {
+        HeadChoice::None => Ok(Vec::new()),
+        HeadChoice::Auto => {
+            let stride = (missing.len() / labels.len().max(1) / 2000).max(1);
+            let chosen = choose_reference(xyz, missing, labels.len(), AUTO_REFERENCE_COUNT, stride);
+            if chosen.len() < 3 {
+                bail!("could not find 3 rigid reference markers; pass --head-reference none or name them");
+            }
+            Ok(chosen)
+        }
+        HeadChoice::Labels(patterns) => {
+            let regions = Regions {
+                regions: [("head_reference".to_string(), patterns.clone())].into(),
+            };
+            let idx = regions
+                .resolve(labels)
+                .map_err(|e| anyhow::anyhow!("head reference: {e}"))?
+                .remove("head_reference")
+                .unwrap_or_default();
+            if idx.len() < 3 {
+                bail!(
+                    "head stabilisation needs at least 3 reference markers, got {}",
+                    idx.len()
+                );
+            }
+            Ok(idx)
+        }
+    }
+}
