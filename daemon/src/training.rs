@@ -234,11 +234,11 @@ fn run_prep(
     Ok((xyz, missing, glitches, residuals))
 }
 
+/// Labels kept, and the labels left out with the share of frames they were missing in.
+type KeptMarkers = (Vec<String>, Vec<(String, f64)>);
+
 /// The first take's labels minus the markers missing too often over all takes.
-fn kept_markers(
-    takes: &[replay::Take],
-    max_share: f64,
-) -> Result<(Vec<String>, Vec<(String, f64)>)> {
+fn kept_markers(takes: &[replay::Take], max_share: f64) -> Result<KeptMarkers> {
     let first = &takes[0].labels;
     let mut missing = vec![0usize; first.len()];
     let mut frames = 0usize;

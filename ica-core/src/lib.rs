@@ -12,8 +12,8 @@ pub mod report;
 pub mod stabilise;
 pub mod whiten;
 
-pub use report::{RestartReport, TrainReport};
 pub use fit::{amari_index, FastIcaParams, FitData, FitError, FitOutput};
+pub use report::{RestartReport, TrainReport};
 
 pub use edit::{EditError, FrameEdit};
 pub use model::{EmotionLevels, IcaModel, ModelError, Role, FORMAT_VERSION};

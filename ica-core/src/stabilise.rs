@@ -467,7 +467,7 @@ mod tests {
         let (frames, _) = scene(3);
         let missing = vec![false; 18];
         assert_eq!(
-            Stabiliser::fit(&frames, &missing, 6, vec![0, 1]).unwrap_err(),
+            Stabiliser::fit(&frames, &missing, 6, vec![0, 1]).expect_err("two references"),
             StabiliseError::TooFewReferences(2)
         );
         assert!(matches!(
@@ -477,7 +477,7 @@ mod tests {
         // Three collinear points.
         let line: Vec<f32> = (0..3).flat_map(|k| [k as f32 * 10.0, 0.0, 0.0]).collect();
         assert_eq!(
-            Stabiliser::fit(&line, &[false; 3], 3, vec![0, 1, 2]).unwrap_err(),
+            Stabiliser::fit(&line, &[false; 3], 3, vec![0, 1, 2]).expect_err("collinear"),
             StabiliseError::Degenerate
         );
     }

@@ -86,7 +86,10 @@ impl Take {
 
     /// Number of frames.
     pub fn n_frames(&self) -> usize {
-        self.missing.len().checked_div(self.n_markers()).unwrap_or(0)
+        self.missing
+            .len()
+            .checked_div(self.n_markers())
+            .unwrap_or(0)
     }
 
     /// Positions of one frame: markers x 3.
@@ -118,7 +121,11 @@ impl Take {
             return None;
         }
         let i = (frame * self.n_markers() + marker) * 3;
-        Some([self.positions[i], self.positions[i + 1], self.positions[i + 2]])
+        Some([
+            self.positions[i],
+            self.positions[i + 1],
+            self.positions[i + 2],
+        ])
     }
 
     /// Appends one frame. `xyz` is markers x 3 (mm); `missing` one flag per marker. Positions of
@@ -191,7 +198,11 @@ impl Take {
             }
         }
         for (i, &gone) in self.missing.iter().enumerate() {
-            if !gone && self.positions[i * 3..i * 3 + 3].iter().any(|v| !v.is_finite()) {
+            if !gone
+                && self.positions[i * 3..i * 3 + 3]
+                    .iter()
+                    .any(|v| !v.is_finite())
+            {
                 return Err(TakeError::NonFinite {
                     frame: i / n,
                     marker: self.labels[i % n].clone(),

@@ -148,7 +148,7 @@ fn print_preparation(data: &PreparedData) -> Result<()> {
         .zip(&data.labels)
         .filter(|(c, _)| *c > 0)
         .collect();
-    worst.sort_by(|a, b| b.0.cmp(&a.0));
+    worst.sort_by_key(|w| std::cmp::Reverse(w.0));
     let names: Vec<String> = worst
         .iter()
         .take(5)

@@ -1,0 +1,214 @@
+//! `emoshift train`: learn an ICA model from takes.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use ica_core::fit::{FastIcaParams, FitData};
+use ica_core::model::IcaModel;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::cli::TrainArgs;
+use crate::exit::UsageError;
+use crate::offline;
+use crate::training::{self, HeadChoice, PrepOptions, PreparedData, SpeedLimit};
+use replay::session::Regions;
+
+/// The regions file's region naming the rigid head markers.
+pub const HEAD_REGION: &str = "head_reference";
+
+fn head_choice(args: &TrainArgs) -> Result<HeadChoice> {
+    if let Some(text) = &args.head_reference {
+        return Ok(match text.as_str() {
+            "none" => HeadChoice::None,
+            "auto" => HeadChoice::Auto,
+            list => HeadChoice::Labels(list.split(',').map(|s| s.trim().to_string()).collect()),
+        });
+    }
+    // The regions file's head reference, when there is one (beside the manifest by default).
+    let regions_path = args.regions.clone().or_else(|| {
+        let p = args.manifest.as_ref()?.parent()?.join("regions.toml");
+        p.exists().then_some(p)
+    });
+    if let Some(path) = regions_path {
+        let regions = Regions::load(&path).with_context(|| format!("{}", path.display()))?;
+        if let Some(patterns) = regions.regions.get(HEAD_REGION) {
+            return Ok(HeadChoice::Labels(patterns.clone()));
+        }
+    }
+    Ok(HeadChoice::Auto)
+}
+
+fn speed_limit(text: &str) -> Result<SpeedLimit> {
+    Ok(match text {
+        "auto" => SpeedLimit::Auto,
+        "off" => SpeedLimit::Off,
+        v => match v.parse::<f64>() {
+            Ok(x) if x.is_finite() && x > 0.0 => SpeedLimit::MmPerS(x),
+            _ => {
+                return Err(UsageError(format!(
+                    "--max-speed {v:?}: expected auto, off or a speed in mm/s"
+                ))
+                .into())
+            }
+        },
+    })
+}
+
+fn params(args: &TrainArgs) -> Result<FastIcaParams> {
+    let mut params = FastIcaParams::default()
+        .seed(args.seed)
+        .restarts(args.restarts)
+        .max_iter(args.max_iter)
+        .tol(args.tol);
+    params = match (args.components, args.variance) {
+        (Some(_), Some(_)) => {
+            return Err(UsageError("give --variance or --components, not both".into()).into())
+        }
+        (Some(m), None) => params.n_components(m),
+        (None, Some(v)) => params.variance_target(v),
+        (None, None) => params,
+    };
+    params.check().map_err(|e| UsageError(e.to_string()))?;
+    Ok(params)
+}
+
+pub(crate) fn run(args: &TrainArgs) -> Result<()> {
+    let params = params(args)?;
+    let started = Instant::now();
+    let bar = ProgressBar::new(0).with_style(
+        ProgressStyle::with_template("{spinner} {msg} [{bar:30}] {pos}/{len}")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    bar.set_message("loading takes");
+    let takes = offline::load_inputs(args.manifest.as_deref(), &args.files)?;
+    bar.set_length(takes.len() as u64);
+    bar.set_position(takes.len() as u64);
+    let options = PrepOptions {
+        rate_hz: args.rate,
+        max_missing_share: args.max_missing,
+        speed: speed_limit(&args.max_speed)?,
+        head: head_choice(args)?,
+        bounds: !args.no_bounds,
+    };
+    let data = training::prepare(&takes, &options)?;
+    let channels = data.labels.len() * 3;
+    let fit_data = FitData::new(&data.samples, channels)?.with_missing(&data.missing)?;
+    bar.set_style(ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("static"));
+    bar.set_message(format!(
+        "whitening and FastICA ({} restarts)",
+        args.restarts
+    ));
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    let fit = params.fit(&fit_data).context("training failed")?;
+    bar.finish_and_clear();
+    let mut model = IcaModel::new(
+        data.labels.clone(),
+        data.rate_hz,
+        fit.mean,
+        fit.mixing,
+        fit.report,
+    )
+    .context("the fitted model failed validation")?;
+    model.set_capture(data.capture.clone())?;
+    let file = std::fs::File::create(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    model
+        .save(std::io::BufWriter::new(file))
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    print_preparation(&data)?;
+    print_summary(&model, takes.len(), started.elapsed().as_secs_f64())?;
+    crate::out!("model: {}", args.out.display());
+    Ok(())
+}
+
+fn print_preparation(data: &PreparedData) -> Result<()> {
+    for (file, from, to) in &data.resampled {
+        crate::out!("resampled {file} from {from} Hz to {to} Hz");
+    }
+    for (label, share) in &data.excluded {
+        crate::out!(
+            "excluded marker {label}: missing in {:.1} % of the frames",
+            100.0 * share
+        );
+    }
+    let limit = match data.capture.max_speed_mm_s {
+        Some(v) => format!("faster than {v:.0} mm/s"),
+        None => "no speed limit".into(),
+    };
+    let bounds = if data.capture.bounds.is_some() {
+        " or outside their marker's learned region"
+    } else {
+        ""
+    };
+    let mut worst: Vec<(usize, &String)> = data
+        .glitches_per_marker
+        .iter()
+        .copied()
+        .zip(&data.labels)
+        .filter(|(c, _)| *c > 0)
+        .collect();
+    worst.sort_by_key(|w| std::cmp::Reverse(w.0));
+    let names: Vec<String> = worst
+        .iter()
+        .take(5)
+        .map(|(c, l)| format!("{l} {c}"))
+        .collect();
+    let detail = if names.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", names.join(", "))
+    };
+    crate::out!(
+        "glitches: {} samples {limit}{bounds} treated as missing{detail}",
+        data.glitches
+    );
+    match data.residual_summary() {
+        Some((median, p95)) => crate::out!(
+            "head stabilised on {}: residual median {median:.2} mm, p95 {p95:.2} mm",
+            data.reference.join(", ")
+        ),
+        None => crate::out!("no head stabilisation"),
+    }
+    Ok(())
+}
+
+fn print_summary(model: &IcaModel, takes: usize, seconds: f64) -> Result<()> {
+    let r = model.report();
+    let best = &r.restarts[r.best_restart];
+    crate::out!(
+        "trained on {takes} takes: used {} of {} frames, {} markers, {} dead channels",
+        r.frames_used,
+        r.frames_total,
+        model.markers(),
+        r.dead_channels.len()
+    );
+    crate::out!(
+        "components: {} keeping {:.2} % of the variance",
+        r.components,
+        100.0 * r.variance_kept
+    );
+    for (i, run) in r.restarts.iter().enumerate() {
+        crate::out!(
+            "  restart {i}: {} iterations, {}, negentropy {:.5}{}",
+            run.iterations,
+            if run.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
+            run.negentropy,
+            if i == r.best_restart { "  <- kept" } else { "" }
+        );
+    }
+    crate::out!(
+        "kept restart {} ({}), {seconds:.2} s",
+        r.best_restart,
+        if best.converged {
+            "converged"
+        } else {
+            "not converged: raise --max-iter"
+        }
+    );
+    Ok(())
+}
