@@ -176,6 +176,51 @@ fn analyze_labels_match_the_generator_truth() {
     }
 }
 
+/// The bar charts show, panel after panel, d_emotion and |d_mouth|, |d_eyebrows|, |d_eyelids|
+/// of every component, as report.json has them; the HTML page shows both figures.
+fn check_figures(dir: &Path, report: &serde_json::Value) {
+    let svg = std::fs::read_to_string(dir.join("report/components.svg")).expect("svg");
+    let values: Vec<f64> = svg
+        .split("data-value=\"")
+        .skip(1)
+        .map(|rest| {
+            rest.split('"')
+                .next()
+                .expect("quoted")
+                .parse()
+                .expect("number")
+        })
+        .collect();
+    let comps = report["components"].as_array().expect("components");
+    let mut expected = Vec::new();
+    for metric in ["d_emotion", "mouth", "eyebrows", "eyelids"] {
+        for c in comps {
+            let v = if metric == "d_emotion" {
+                c["d_emotion"].as_f64().expect("paired session")
+            } else {
+                c["d_region"][metric].as_f64().expect("region metric").abs()
+            };
+            expected.push(v);
+        }
+    }
+    assert_eq!(
+        values.len(),
+        expected.len(),
+        "one bar per component per panel"
+    );
+    for (v, e) in values.iter().zip(&expected) {
+        assert!((v - e).abs() < 1e-5, "bar {v} vs report {e}");
+    }
+    let html = std::fs::read_to_string(dir.join("report/report.html")).expect("html");
+    assert!(html.contains("src=\"components.svg\"") && html.contains("src=\"timeline.svg\""));
+    let timeline = std::fs::read_to_string(dir.join("report/timeline.svg")).expect("timeline");
+    assert_eq!(
+        timeline.matches("<path ").count(),
+        comps.len(),
+        "one series per component"
+    );
+}
+
 /// R² of the true speech-driven mouth displacement (all mouth channels together) regressed on
 /// the chosen components.
 fn speech_mouth_r_squared(
