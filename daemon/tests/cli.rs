@@ -1,0 +1,253 @@
+//! The command line as a user runs it: formats, errors, the offline round trip, and analysis
+//! without emotion pairs.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_emoshift"))
+        .args(args)
+        .output()
+        .expect("emoshift runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "emoshift {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Runs a command that must fail: exit code 1, one line on stderr naming `needle`, no panic.
+fn fails(args: &[&str], needle: &str) {
+    let out = run(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "emoshift {args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.contains(needle), "{err:?} should name {needle:?}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+fn p(path: &Path) -> &str {
+    path.to_str().expect("utf-8 path")
+}
+
+#[test]
+fn synth_output_reads_back_identically_in_all_three_formats() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut takes = Vec::new();
+    for format in ["c3d", "trc", "csv"] {
+        let out = dir.path().join(format);
+        ok(&[
+            "synth",
+            "--out",
+            p(&out),
+            "--sentences",
+            "1",
+            "--seed",
+            "4",
+            "--format",
+            format,
+        ]);
+        takes.push(replay::load(&out.join(format!("s01_happy.{format}"))).expect("take loads"));
+    }
+    let (a, b, c) = (&takes[0], &takes[1], &takes[2]);
+    for other in [b, c] {
+        assert_eq!(a.labels, other.labels);
+        assert_eq!(a.rate_hz, other.rate_hz);
+        assert_eq!(a.first_frame, other.first_frame);
+        assert_eq!(a.missing, other.missing);
+        let worst = a
+            .positions
+            .iter()
+            .zip(&other.positions)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-3, "formats differ by {worst} mm");
+    }
+}
+
+#[test]
+fn bad_input_gets_one_clear_line_and_exit_code_1() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    fails(&["info", p(&d.join("nope.c3d"))], "nope.c3d");
+    std::fs::write(d.join("x.xyz"), "hello").expect("write");
+    fails(&["info", p(&d.join("x.xyz"))], "unknown take format");
+    std::fs::write(
+        d.join("nan.csv"),
+        "frame,time,a_x,a_y,a_z\n1,0,1,2,inf\n2,0.01,1,2,3\n",
+    )
+    .expect("write");
+    fails(&["info", p(&d.join("nan.csv"))], "nan.csv");
+    std::fs::write(
+        d.join("empty.csv"),
+        "# rate_hz=120 units=mm\nframe,time,a_x,a_y,a_z\n",
+    )
+    .expect("write");
+    fails(
+        &[
+            "train",
+            p(&d.join("empty.csv")),
+            "--out",
+            p(&d.join("m.json")),
+        ],
+        "no frames",
+    );
+    // Two markers moving together: rank 1, so 5 components cannot exist.
+    let mut rows = String::from("# rate_hz=100 units=mm\nframe,time,a_x,a_y,a_z,b_x,b_y,b_z\n");
+    for f in 0..200 {
+        let v = (f as f64 * 0.1).sin();
+        rows += &format!("{},{},{v},0,0,{v},0,0\n", f + 1, f as f64 / 100.0);
+    }
+    std::fs::write(d.join("rank.csv"), rows).expect("write");
+    fails(
+        &[
+            "train",
+            p(&d.join("rank.csv")),
+            "--out",
+            p(&d.join("m.json")),
+            "--components",
+            "5",
+            "--head-reference",
+            "none",
+        ],
+        "rank",
+    );
+    std::fs::write(
+        d.join("bad.json"),
+        "{\"format_version\": 1, \"labels\": []}",
+    )
+    .expect("write");
+    fails(&["inspect", p(&d.join("bad.json"))], "bad.json");
+    let out = run(&[
+        "edit",
+        "--model",
+        "m.json",
+        "x.c3d",
+        "--out",
+        "y.c3d",
+        "--translate",
+        "zero=1",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "a malformed flag is a usage error"
+    );
+}
+
+#[test]
+fn train_project_edit_round_trip_on_synth_output() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let s = dir.path().join("s");
+    ok(&["synth", "--out", p(&s), "--sentences", "2", "--seed", "9"]);
+    let model = dir.path().join("m.json");
+    let out = ok(&[
+        "train",
+        "--manifest",
+        p(&s.join("session.toml")),
+        "--out",
+        p(&model),
+        "--components",
+        "8",
+    ]);
+    assert!(out.contains("converged"), "{out}");
+    let csv = dir.path().join("u.csv");
+    ok(&[
+        "project",
+        "--model",
+        p(&model),
+        p(&s.join("s01_happy.c3d")),
+        "--out",
+        p(&csv),
+    ]);
+    let text = std::fs::read_to_string(&csv).expect("components");
+    let header = text.lines().next().expect("header");
+    assert_eq!(header, "frame,time,c0,c1,c2,c3,c4,c5,c6,c7");
+    let take = replay::load(&s.join("s01_happy.c3d")).expect("take");
+    assert_eq!(text.lines().count(), take.n_frames() + 1);
+    let edited = dir.path().join("e.trc");
+    ok(&[
+        "edit",
+        "--model",
+        p(&model),
+        p(&s.join("s01_happy.c3d")),
+        "--out",
+        p(&edited),
+        "--translate",
+        "0=2",
+        "--gain",
+        "1=0.5",
+    ]);
+    let e = replay::load(&edited).expect("edited take");
+    assert_eq!(e.n_frames(), take.n_frames());
+    assert_eq!(e.labels, take.labels);
+    // A translate of two units moves markers by about twice component 0's mixing norm.
+    let moved = e
+        .positions
+        .iter()
+        .zip(&take.positions)
+        .map(|(a, b)| f64::from(a - b).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(moved > 1.0, "the edit changed nothing ({moved})");
+}
+
+#[test]
+fn analyze_without_pairs_reports_regions_and_why_emotion_is_missing() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let take = root.join("../replay/tests/fixtures/Facial-Sing.c3d");
+    let regions = root.join("tests/fixtures/facial-sing.regions.toml");
+    let model = dir.path().join("m.json");
+    ok(&[
+        "train",
+        p(&take),
+        "--out",
+        p(&model),
+        "--regions",
+        p(&regions),
+    ]);
+    let manifest = dir.path().join("session.toml");
+    std::fs::write(
+        &manifest,
+        format!(
+            "rate_hz = 100\n[[take]]\nfile = {:?}\nsentence = \"song\"\nemotion = \"neutral\"\n",
+            p(&take)
+        ),
+    )
+    .expect("manifest");
+    let report_dir = dir.path().join("report");
+    let out = ok(&[
+        "analyze",
+        "--model",
+        p(&model),
+        "--manifest",
+        p(&manifest),
+        "--regions",
+        p(&regions),
+        "--out",
+        p(&report_dir),
+    ]);
+    assert!(out.contains("emotion not measured"), "{out}");
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(report_dir.join("report.json")).expect("report"),
+    )
+    .expect("json");
+    assert_eq!(report["emotion_measured"], false);
+    let roles: Vec<&str> = report["components"]
+        .as_array()
+        .expect("components")
+        .iter()
+        .map(|c| c["role"].as_str().expect("role"))
+        .collect();
+    assert!(
+        roles.contains(&"speech"),
+        "a singer's mouth moves: {roles:?}"
+    );
+    assert!(!roles.contains(&"emotion"));
+}
