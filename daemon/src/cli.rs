@@ -54,6 +54,12 @@ pub enum Command {
         after_help = "Example:\n  emoshift analyze --model model.json --manifest session/session.toml --out report --write-model"
     )]
     Analyze(AnalyzeArgs),
+    /// Send a take over UDP at its rate, as a live source would (OSC /mocap/frame + labels).
+    #[command(
+        after_help = "Examples:\n  emoshift replay take.c3d --to 127.0.0.1:9000\n  \
+        emoshift replay take.trc --to 127.0.0.1:9000 --speed 2 --loop --start-frame 120"
+    )]
+    Replay(ReplayArgs),
 }
 
 /// `emoshift synth`.
@@ -260,4 +266,43 @@ pub struct AnalyzeArgs {
     /// Store the roles and emotion levels in the model file.
     #[arg(long)]
     pub write_model: bool,
+}
+
+/// `emoshift replay`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// The take (.c3d, .trc or .csv).
+    pub file: PathBuf,
+    /// Where to send, HOST:PORT (e.g. the daemon's --listen address).
+    #[arg(long, value_name = "HOST:PORT")]
+    pub to: String,
+    /// Playback speed: 2 sends twice as fast (capture times stay in take time).
+    #[arg(long, default_value_t = 1.0)]
+    pub speed: f64,
+    /// After the last frame start again from the first, until Ctrl-C; frame numbers keep
+    /// increasing.
+    #[arg(long = "loop")]
+    pub looping: bool,
+    /// Index (0-based, whatever the file numbers it) of the first frame to send.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub start_frame: usize,
+    /// Layout id sent in /mocap/labels.
+    #[arg(long, default_value_t = 0, value_name = "ID")]
+    pub layout_id: i32,
+    /// Frame encoding: blob (`,ihbb`, with a missing-marker mask) or flat (`,ih` + floats, NaN
+    /// for missing).
+    #[arg(long, value_enum, default_value_t = WireFormat::Blob)]
+    pub format: WireFormat,
+    /// Overdue frames sent back to back after a stall; further behind, skip to the present.
+    #[arg(long, default_value_t = replay::pacer::DEFAULT_MAX_BEHIND_FRAMES, value_name = "FRAMES")]
+    pub max_behind: u64,
+}
+
+/// The `/mocap/frame` encoding of `emoshift replay`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum WireFormat {
+    /// `,ihbb`: frame, time, missing-marker mask blob, positions blob.
+    Blob,
+    /// `,ih` then 3 floats per marker, all NaN for a missing marker.
+    Flat,
 }

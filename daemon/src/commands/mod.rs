@@ -6,6 +6,7 @@ mod edit;
 mod info;
 mod inspect;
 mod project;
+mod replay;
 mod synth;
 mod train;
 
@@ -27,11 +28,12 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Edit(args) => edit::run(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Analyze(args) => analyze::run(&args),
+        Command::Replay(args) => replay::run(&args),
     }
 }
 
 /// Loads a take, naming the file in the error.
-pub(crate) fn load_take(path: &std::path::Path) -> Result<replay::Take> {
+pub(crate) fn load_take(path: &std::path::Path) -> Result<::replay::Take> {
     crate::offline::load_take(path)
 }
 
