@@ -195,3 +195,29 @@ fn bad_input_is_rejected_with_typed_errors() {
     assert_eq!(take.n_frames(), 1);
     assert_eq!(take.sample(0, 1), None);
 }
+
+/// Frames reach the file while recording (a crash loses at most the write buffer), and memory
+/// does not hold the take: the file grows with every buffer's worth of frames.
+#[test]
+fn frames_reach_the_file_as_they_are_pushed() {
+    let dir = tempfile::tempdir().unwrap();
+    for ext in ["c3d", "trc", "csv"] {
+        let path = dir.path().join(format!("stream.{ext}"));
+        let labels: Vec<String> = (0..40).map(|i| format!("m{i}")).collect();
+        let mut rec = Recorder::create(&path, labels, 120.0, 1).unwrap();
+        let xyz: Vec<f32> = (0..120).map(|v| v as f32 * 1.25).collect();
+        let missing = [false; 40];
+        let mut sizes = Vec::new();
+        for f in 0..600 {
+            rec.push_frame(&xyz, &missing).unwrap();
+            if f % 200 == 199 {
+                sizes.push(std::fs::metadata(&path).unwrap().len());
+            }
+        }
+        // 200 frames of 40 markers are over 64 KiB in every format: each checkpoint grew.
+        assert!(sizes.windows(2).all(|w| w[1] > w[0]), "{ext}: {sizes:?}");
+        assert_eq!(rec.frames(), 600);
+        rec.finish().unwrap();
+        assert_eq!(replay::load(&path).unwrap().n_frames(), 600);
+    }
+}
