@@ -1,7 +1,8 @@
 //! Recorded takes on disk (C3D, TRC, CSV), the synthetic face generator and the replay pacer.
 //!
 //! Main types: [`Take`] (labels, rate, first frame, positions in mm, missing mask), [`Format`],
-//! [`load`] and [`save`].
+//! [`load`] and [`save`]; [`pacer::Pacer`], the sans-IO schedule `emoshift replay` sends a take
+//! on; [`record::Recorder`], which writes a take frame by frame as it arrives.
 //!
 //! This crate must not know about ICA models (the daemon joins takes and models).
 #![warn(missing_docs)]
