@@ -9,7 +9,7 @@
 //! empty parameter section), the points are decoded by our own parser from the header and
 //! whatever parameters there are, with generated labels `M001`, `M002`... where none are stored.
 //!
-//! Writing produces what strict readers (ezc3d, py-c3d) accept: see [`write`].
+//! Writing produces what strict readers (ezc3d, py-c3d) accept: see [`write()`].
 
 mod binary;
 mod decode;
