@@ -49,6 +49,15 @@ pub enum Command {
         after_help = "Examples:\n  emoshift inspect model.json\n  emoshift inspect model.json --json"
     )]
     Inspect(InspectArgs),
+    /// Run the live service: receive frames, edit their emotion, send them to subscribers.
+    #[command(
+        after_help = "Examples:\n  emoshift serve --model model.json --send 127.0.0.1:9100\n  \
+        emoshift serve --config emoshift.toml --listen 127.0.0.1:9000 --send 239.0.0.1:9100:flat-split"
+    )]
+    Serve(ServeArgs),
+    /// Measure the service on loopback against a plain UDP relay: added latency, loss, throughput.
+    #[command(after_help = "Example:\n  emoshift bench --performers 2 --clients 4 --seconds 3")]
+    Bench(BenchArgs),
     /// Label the components (emotion, speech, eyebrows, eyelids) and write the report.
     #[command(
         after_help = "Example:\n  emoshift analyze --model model.json --manifest session/session.toml --out report --write-model"
@@ -219,6 +228,44 @@ pub struct InspectArgs {
     /// Print the whole model as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `emoshift serve`. Flags override the config file.
+#[derive(Debug, Args)]
+pub struct ServeArgs {
+    /// TOML config file (every flag has a key; see docs/emoshift.toml).
+    #[arg(long, env = "EMOSHIFT_CONFIG")]
+    pub config: Option<PathBuf>,
+    /// Model file (JSON).
+    #[arg(long, env = "EMOSHIFT_MODEL")]
+    pub model: Option<PathBuf>,
+    /// Frame socket, IP:PORT [default: 127.0.0.1:9000].
+    #[arg(long, value_name = "IP:PORT")]
+    pub listen: Option<String>,
+    /// Control socket, IP:PORT [default: 127.0.0.1:9001].
+    #[arg(long, value_name = "IP:PORT")]
+    pub control: Option<String>,
+    /// Static subscriber HOST:PORT[:profile] (compact, flat-split, components); repeatable,
+    /// replaces the config's list.
+    #[arg(long, value_name = "HOST:PORT[:PROFILE]")]
+    pub send: Vec<String>,
+    /// Low-pass window of the emotion edit, seconds [default: 1].
+    #[arg(long)]
+    pub lowpass: Option<f32>,
+}
+
+/// `emoshift bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Senders (performers), each at 120 Hz.
+    #[arg(long, default_value_t = 1)]
+    pub performers: usize,
+    /// Receivers (subscribers).
+    #[arg(long, default_value_t = 2)]
+    pub clients: usize,
+    /// Seconds of each timed run.
+    #[arg(long, default_value_t = 3.0)]
+    pub seconds: f64,
 }
 
 /// A `k=value` pair of `--translate` and `--gain`.

@@ -13,6 +13,7 @@ pub mod frame;
 pub mod layout;
 pub mod logging;
 pub mod offline;
+pub mod serve;
 pub mod training;
 
 /// `println!` that returns the I/O error instead of panicking, so `emoshift info x | head` ends

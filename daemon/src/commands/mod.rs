@@ -1,12 +1,14 @@
 //! One module per subcommand; [`run`] dispatches.
 
 mod analyze;
+mod bench;
 mod convert;
 mod edit;
 mod info;
 mod inspect;
 mod project;
 mod replay;
+mod serve;
 mod synth;
 mod train;
 
@@ -28,6 +30,8 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Edit(args) => edit::run(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Analyze(args) => analyze::run(&args),
+        Command::Serve(args) => serve::run(&args),
+        Command::Bench(args) => bench::run(&args),
         Command::Replay(args) => replay::run(&args),
     }
 }

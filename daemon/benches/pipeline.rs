@@ -1,0 +1,53 @@
+//! The whole live frame path (decode → map → project → edit → resynthesise → encode) at 109
+//! markers and m = 20, through `Pipeline::handle_datagram`; budget 2 µs a frame (issue 7).
+
+use std::net::SocketAddr;
+use std::sync::Arc;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use daemon::serve::pipeline::{Pipeline, PipelineConfig};
+use daemon::serve::synthetic::{frame_into, random_model};
+use protocol::{encode_frame_into, encode_labels_into, FrameBuf, Labels};
+
+fn whole_frame_path(c: &mut Criterion) {
+    let model = Arc::new(random_model(109, 20, 1));
+    let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let peer: SocketAddr = "127.0.0.1:9".parse().expect("literal address");
+    let mut labels = Vec::new();
+    let names = model.labels().to_vec();
+    encode_labels_into(
+        &Labels {
+            layout_id: 0,
+            names,
+        },
+        &mut labels,
+    )
+    .expect("valid labels");
+    pipeline.handle_datagram(peer, &labels, &mut |_| {});
+    let mut xyz = vec![0.0; 109 * 3];
+    let mut buf = FrameBuf::with_max_markers(109);
+    let datagrams: Vec<Vec<u8>> = (0..120)
+        .map(|f| {
+            frame_into(&model, f, &mut xyz);
+            buf.set_frame(0, 0, &xyz).expect("finite");
+            let mut d = Vec::new();
+            encode_frame_into(&buf, &mut d).expect("finite");
+            d
+        })
+        .collect();
+    let mut n: i32 = 0;
+    c.bench_function("pipeline 109 markers m=20 compact", |b| {
+        b.iter(|| {
+            let d = &mut datagrams[n as usize % 120].clone();
+            // Frame numbers must increase or the stream drops the frame as stale.
+            d[24..28].copy_from_slice(&n.to_be_bytes());
+            n += 1;
+            let mut out = 0;
+            pipeline.handle_datagram(peer, d, &mut |e| out += e.compact.len());
+            out
+        })
+    });
+}
+
+criterion_group!(benches, whole_frame_path);
+criterion_main!(benches);

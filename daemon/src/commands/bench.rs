@@ -1,0 +1,317 @@
+//! `emoshift bench`: the daemon against a plain UDP relay on loopback, in one run.
+//!
+//! 1. Paced: N senders at 120 Hz, K receivers, through the daemon and then through a minimal
+//!    relay (receive, send the same bytes to every receiver). Each frame carries its send time
+//!    in the capture-time field, which the daemon keeps, so a receiver measures the whole path.
+//! 2. Max rate: one sender at 50,000 frames/s through the daemon to one receiver: loss.
+//! 3. One processing thread: frames through [`Pipeline`] back to back (109 markers, m = 20).
+//!
+//! Bounded in time, only 127.0.0.1.
+
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use hdrhistogram::Histogram;
+use ica_core::model::IcaModel;
+use protocol::{
+    decode_frame_into, encode_frame_into, encode_labels_into, messages, FrameBuf, Labels,
+};
+use tokio::net::UdpSocket;
+use tokio_util::sync::CancellationToken;
+
+use crate::cli::BenchArgs;
+use crate::serve::config::RawConfig;
+use crate::serve::pipeline::{Pipeline, PipelineConfig};
+use crate::serve::stats::Stats;
+use crate::serve::synthetic::{frame_into, random_model};
+
+const MARKERS: usize = 109;
+const COMPONENTS: usize = 20;
+const MAX_RATE_HZ: f64 = 50_000.0;
+
+/// What the receivers saw.
+struct Seen {
+    latency_us: Histogram<u64>,
+    received: u64,
+}
+
+pub(crate) fn run(args: &BenchArgs) -> Result<()> {
+    if args.performers == 0 || args.clients == 0 || !(args.seconds > 0.0 && args.seconds <= 60.0) {
+        return Err(crate::exit::UsageError(
+            "--performers and --clients must be at least 1, --seconds in (0, 60]".into(),
+        )
+        .into());
+    }
+    let model = random_model(MARKERS, COMPONENTS, 1);
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .context("starting the tokio runtime")?;
+    let secs = Duration::from_secs_f64(args.seconds);
+    let (daemon, relay, max) = runtime.block_on(async {
+        let daemon = through_daemon(&model, args.performers, args.clients, 120.0, secs).await?;
+        let relay = through_relay(&model, args.performers, args.clients, secs).await?;
+        let max = through_daemon(&model, 1, 1, MAX_RATE_HZ, Duration::from_secs(1)).await?;
+        anyhow::Ok((daemon, relay, max))
+    })?;
+    let sent = (args.performers as f64 * 120.0 * args.seconds).round() as u64 * args.clients as u64;
+    crate::out!(
+        "paced: {} performers x 120 Hz, {} clients, {} s, {MARKERS} markers, m = {COMPONENTS}",
+        args.performers,
+        args.clients,
+        args.seconds
+    );
+    for (name, s) in [("daemon", &daemon), ("relay", &relay)] {
+        crate::out!("  {name}: {} of ~{sent} datagrams received", s.0.received);
+    }
+    for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999), ("max", 1.0)] {
+        let d = daemon.0.latency_us.value_at_quantile(q);
+        let r = relay.0.latency_us.value_at_quantile(q);
+        crate::out!(
+            "{label} added latency: {d} µs (relay {r} µs, ratio {:.2}x)",
+            d as f64 / r.max(1) as f64
+        );
+    }
+    let max_sent = MAX_RATE_HZ as u64;
+    crate::out!(
+        "max rate: {} frames sent at {MAX_RATE_HZ} /s, {} received, loss {:.3}%",
+        max.1,
+        max.0.received,
+        100.0 * (1.0 - max.0.received as f64 / max.1.max(1) as f64)
+    );
+    let _ = max_sent;
+    let (per_frame_us, fps) = processing_rate(&model)?;
+    crate::out!(
+        "processing: {per_frame_us:.2} µs/frame median over batches, {fps:.0} frames/s on one thread"
+    );
+    Ok(())
+}
+
+/// Paced traffic through the daemon; returns what receivers saw and frames sent.
+async fn through_daemon(
+    model: &IcaModel,
+    performers: usize,
+    clients: usize,
+    rate_hz: f64,
+    secs: Duration,
+) -> Result<(Seen, u64)> {
+    let (receivers, addrs) = receivers(clients).await?;
+    let mut raw = RawConfig {
+        listen: Some("127.0.0.1:0".into()),
+        control: Some("127.0.0.1:0".into()),
+        model: Some("unused".into()),
+        queue: Some(1024),
+        stats_interval_s: Some(3600.0),
+        ..RawConfig::default()
+    };
+    raw.send = addrs.iter().map(|a| a.to_string()).collect();
+    let config = raw.validate()?;
+    let bound = crate::serve::bind_with(config, model.clone()).await?;
+    let to = bound.frame_addr()?;
+    let shutdown = CancellationToken::new();
+    let server = tokio::spawn(bound.run(shutdown.clone()));
+    let sent = send_all(model, performers, to, rate_hz, secs).await?;
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    shutdown.cancel();
+    server.await.context("daemon task")??;
+    Ok((collect(receivers).await, sent))
+}
+
+/// The same traffic through a minimal relay.
+async fn through_relay(
+    model: &IcaModel,
+    performers: usize,
+    clients: usize,
+    secs: Duration,
+) -> Result<(Seen, u64)> {
+    let (receivers, addrs) = receivers(clients).await?;
+    let relay = UdpSocket::bind("127.0.0.1:0").await?;
+    let to = relay.local_addr()?;
+    let stop = CancellationToken::new();
+    let stop2 = stop.clone();
+    let task = tokio::spawn(async move {
+        let mut buf = vec![0u8; 65_536];
+        loop {
+            let n = tokio::select! {
+                () = stop2.cancelled() => break,
+                r = relay.recv_from(&mut buf) => match r { Ok((n, _)) => n, Err(_) => continue },
+            };
+            for a in &addrs {
+                let _ = relay.send_to(&buf[..n], a).await;
+            }
+        }
+    });
+    let sent = send_all(model, performers, to, 120.0, secs).await?;
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    stop.cancel();
+    task.await.context("relay task")?;
+    Ok((collect(receivers).await, sent))
+}
+
+type Receivers = Vec<(tokio::task::JoinHandle<Seen>, CancellationToken)>;
+
+async fn receivers(k: usize) -> Result<(Receivers, Vec<SocketAddr>)> {
+    let mut out = Vec::with_capacity(k);
+    let mut addrs = Vec::with_capacity(k);
+    for _ in 0..k {
+        let sock = UdpSocket::bind("127.0.0.1:0").await?;
+        addrs.push(sock.local_addr()?);
+        let stop = CancellationToken::new();
+        let stop2 = stop.clone();
+        out.push((tokio::spawn(receive(sock, stop2)), stop));
+    }
+    Ok((out, addrs))
+}
+
+async fn receive(sock: UdpSocket, stop: CancellationToken) -> Seen {
+    let mut seen = Seen {
+        latency_us: Stats::histogram(),
+        received: 0,
+    };
+    let mut buf = vec![0u8; 65_536];
+    let mut frame = FrameBuf::with_max_markers(MARKERS);
+    loop {
+        let n = tokio::select! {
+            () = stop.cancelled() => break,
+            r = sock.recv(&mut buf) => match r { Ok(n) => n, Err(_) => continue },
+        };
+        let now = epoch_us();
+        let Ok(msgs) = messages(&buf[..n], &protocol::Limits::default()) else {
+            continue;
+        };
+        for m in msgs {
+            if let Ok(h) = decode_frame_into(m.bytes, &mut frame) {
+                seen.received += 1;
+                Stats::record(
+                    &mut seen.latency_us,
+                    now.saturating_sub(h.capture_time_us as u64),
+                );
+            }
+        }
+    }
+    seen
+}
+
+async fn collect(receivers: Receivers) -> Seen {
+    let mut all = Seen {
+        latency_us: Stats::histogram(),
+        received: 0,
+    };
+    for (task, stop) in receivers {
+        stop.cancel();
+        if let Ok(s) = task.await {
+            all.received += s.received;
+            let _ = all.latency_us.add(&s.latency_us);
+        }
+    }
+    all
+}
+
+/// Microseconds since the process's bench epoch (shared by senders and receivers).
+fn epoch_us() -> u64 {
+    static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    EPOCH.get_or_init(Instant::now).elapsed().as_micros() as u64
+}
+
+/// N senders at `rate_hz` on absolute deadlines for `secs`; returns frames sent.
+async fn send_all(
+    model: &IcaModel,
+    performers: usize,
+    to: SocketAddr,
+    rate_hz: f64,
+    secs: Duration,
+) -> Result<u64> {
+    let total = Arc::new(AtomicU64::new(0));
+    let mut tasks = Vec::with_capacity(performers);
+    let frames = (rate_hz * secs.as_secs_f64()) as u64;
+    for p in 0..performers {
+        let sock = UdpSocket::bind("127.0.0.1:0").await?;
+        let mut labels = Vec::new();
+        let names = model.labels().to_vec();
+        encode_labels_into(
+            &Labels {
+                layout_id: 0,
+                names,
+            },
+            &mut labels,
+        )?;
+        sock.send_to(&labels, to).await?;
+        let mut xyz = vec![0.0f32; MARKERS * 3];
+        frame_into(model, p, &mut xyz);
+        let total = Arc::clone(&total);
+        tasks.push(tokio::spawn(async move {
+            tokio::time::sleep(Duration::from_millis(20)).await;
+            let period = Duration::from_secs_f64(1.0 / rate_hz);
+            let start = tokio::time::Instant::now();
+            let mut buf = FrameBuf::with_max_markers(MARKERS);
+            let mut out = Vec::with_capacity(2048);
+            for n in 0..frames {
+                let due = start + period.mul_f64(n as f64);
+                if due > tokio::time::Instant::now() {
+                    tokio::time::sleep_until(due).await;
+                }
+                let t = epoch_us() as i64;
+                if buf.set_frame(n as i32, t, &xyz).is_ok()
+                    && encode_frame_into(&buf, &mut out).is_ok()
+                {
+                    let _ = sock.send_to(&out, to).await;
+                    total.fetch_add(1, Ordering::Relaxed);
+                }
+            }
+        }));
+    }
+    for t in tasks {
+        t.await.context("sender task")?;
+    }
+    Ok(total.load(Ordering::Relaxed))
+}
+
+/// Frames through one [`Pipeline`] back to back: median µs/frame over batches, frames/s.
+fn processing_rate(model: &IcaModel) -> Result<(f64, f64)> {
+    let model = Arc::new(model.clone());
+    let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let peer: SocketAddr = "127.0.0.1:9".parse()?;
+    let mut d = Vec::new();
+    let names = model.labels().to_vec();
+    encode_labels_into(
+        &Labels {
+            layout_id: 0,
+            names,
+        },
+        &mut d,
+    )?;
+    pipeline.handle_datagram(peer, &d, &mut |_| {});
+    let mut xyz = vec![0.0f32; MARKERS * 3];
+    frame_into(&model, 3, &mut xyz);
+    let mut buf = FrameBuf::with_max_markers(MARKERS);
+    buf.set_frame(0, 0, &xyz)?;
+    encode_frame_into(&buf, &mut d)?;
+    let (batch, batches) = (2_000usize, 25usize);
+    let mut per_frame = Vec::with_capacity(batches);
+    let mut n: i32 = 0;
+    let start = Instant::now();
+    for _ in 0..batches {
+        let t = Instant::now();
+        for _ in 0..batch {
+            n += 1;
+            // frame number: after "/mocap/frame\0..." (16) and ",ihbb\0\0\0" (8)
+            d[24..28].copy_from_slice(&n.to_be_bytes());
+            pipeline.handle_datagram(peer, &d, &mut |_| {});
+        }
+        per_frame.push(t.elapsed().as_secs_f64() * 1e6 / batch as f64);
+    }
+    let total = start.elapsed().as_secs_f64();
+    per_frame.sort_by(f64::total_cmp);
+    if pipeline.counters.frames_out != (batch * batches) as u64 {
+        anyhow::bail!(
+            "the pipeline dropped frames: {} of {} out",
+            pipeline.counters.frames_out,
+            batch * batches
+        );
+    }
+    Ok((per_frame[batches / 2], (batch * batches) as f64 / total))
+}

@@ -1,0 +1,87 @@
+//! `emoshift serve`: config file + flags → [`Config`], a tokio runtime, Ctrl-C/SIGTERM turned
+//! into one cancellation token, then [`crate::serve::run`]. Exits 0 after a clean shutdown.
+
+use anyhow::{Context, Result};
+use tokio_util::sync::CancellationToken;
+
+use crate::cli::ServeArgs;
+use crate::exit::UsageError;
+use crate::serve::config::RawConfig;
+use crate::serve::Config;
+
+/// Reads the config file (if any) and lays the flags over it, then validates once.
+///
+/// # Errors
+/// Unreadable file, unknown key, bad value (named).
+pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
+    let mut raw = match &args.config {
+        Some(path) => {
+            let text =
+                std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+            RawConfig::from_toml(&text).with_context(|| format!("{}", path.display()))?
+        }
+        None => RawConfig::default(),
+    };
+    if let Some(m) = &args.model {
+        raw.model = Some(m.clone());
+    }
+    if let Some(l) = &args.listen {
+        raw.listen = Some(l.clone());
+    }
+    if let Some(c) = &args.control {
+        raw.control = Some(c.clone());
+    }
+    if !args.send.is_empty() {
+        raw.send = args.send.clone();
+    }
+    if let Some(l) = args.lowpass {
+        raw.lowpass_s = Some(l);
+    }
+    raw.validate().map_err(|e| UsageError(e.to_string()).into())
+}
+
+pub(crate) fn run(args: &ServeArgs) -> Result<()> {
+    let config = config(args)?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .context("starting the tokio runtime")?;
+    runtime.block_on(async move {
+        let shutdown = CancellationToken::new();
+        let bound = crate::serve::bind(config).await?;
+        tracing::info!(
+            frames = %bound.frame_addr()?,
+            control = %bound.control_addr()?,
+            "serving"
+        );
+        tokio::spawn(cancel_on_signal(shutdown.clone()));
+        bound.run(shutdown).await
+    })?;
+    // Anything still blocking (a stuck send) must not hold the exit past the 1 s budget.
+    runtime.shutdown_timeout(std::time::Duration::from_millis(200));
+    Ok(())
+}
+
+/// Cancels `token` on Ctrl-C or SIGTERM.
+async fn cancel_on_signal(token: CancellationToken) {
+    #[cfg(unix)]
+    {
+        use tokio::signal::unix::{signal, SignalKind};
+        match signal(SignalKind::terminate()) {
+            Ok(mut term) => {
+                tokio::select! {
+                    _ = tokio::signal::ctrl_c() => {}
+                    _ = term.recv() => {}
+                }
+            }
+            Err(_) => {
+                let _ = tokio::signal::ctrl_c().await;
+            }
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = tokio::signal::ctrl_c().await;
+    tracing::info!("shutting down");
+    token.cancel();
+}

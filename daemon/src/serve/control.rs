@@ -1,0 +1,210 @@
+//! The control task: decodes control messages, routes them (edits, models and recordings to
+//! the processing thread, subscriptions to the sender) and answers each with
+//! `<address>/confirm` or `/emoshift/error`. Model loads run on a blocking thread; SIGHUP
+//! reloads the last model file.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use crossbeam_channel::Sender;
+use ica_core::model::IcaModel;
+use protocol::{
+    decode_control, encode_confirm_into, encode_error_into, encode_status_into, Control,
+};
+use tokio::net::UdpSocket;
+use tokio::sync::{mpsc, oneshot};
+use tokio_util::sync::CancellationToken;
+use tokio_util::task::TaskTracker;
+
+use super::sender::ClientCmd;
+use super::server::Answer;
+use super::stats::Stats;
+
+/// How long a control message waits for the processing thread's answer.
+const ANSWER_TIMEOUT: Duration = Duration::from_secs(2);
+
+/// A command for the processing thread, applied between frames.
+#[derive(Debug)]
+pub(crate) enum Cmd {
+    /// An edit setting.
+    Edit(Control, Answer),
+    /// Swap in a validated model.
+    SetModel(Arc<IcaModel>, Answer),
+    /// Start recording to a path.
+    RecordStart(PathBuf, Answer),
+    /// Stop recording.
+    RecordStop(Answer),
+}
+
+/// What the control task needs.
+#[derive(Debug, Clone)]
+pub(crate) struct ControlCtx {
+    pub(crate) socket: Arc<UdpSocket>,
+    pub(crate) cmd_tx: Sender<Cmd>,
+    pub(crate) client_tx: mpsc::Sender<ClientCmd>,
+    pub(crate) stats: Arc<Mutex<Stats>>,
+    pub(crate) model_path: Arc<Mutex<PathBuf>>,
+    pub(crate) tracker: TaskTracker,
+}
+
+/// Serves the control socket until shutdown.
+pub(crate) async fn run(ctx: ControlCtx, shutdown: CancellationToken) {
+    let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
+    loop {
+        let (len, peer) = tokio::select! {
+            () = shutdown.cancelled() => break,
+            r = ctx.socket.recv_from(&mut buf) => match r {
+                Ok(r) => r,
+                Err(e) => {
+                    tracing::trace!(error = %e, "control socket receive error");
+                    continue;
+                }
+            },
+        };
+        let control = match decode_control(&buf[..len]) {
+            Ok(c) => c,
+            Err(e) => {
+                tracing::debug!(%peer, error = %e, "refused control message");
+                let address = refused_address(&buf[..len]);
+                reply(&ctx, peer, &address, Err(e.to_string())).await;
+                continue;
+            }
+        };
+        if let Control::ModelLoad(path) = &control {
+            // Loading may take a while: answer from its own task, keep serving.
+            let (ctx2, path) = (ctx.clone(), PathBuf::from(path));
+            ctx.tracker.spawn(async move {
+                match reload(&ctx2, path).await {
+                    Ok(()) => confirm(&ctx2, peer, &control).await,
+                    Err(e) => reply(&ctx2, peer, protocol::address::MODEL_LOAD, Err(e)).await,
+                }
+            });
+            continue;
+        }
+        handle(&ctx, peer, control).await;
+    }
+}
+
+/// The address of a refused message, for the error reply (empty when unreadable).
+fn refused_address(bytes: &[u8]) -> String {
+    protocol::messages(bytes, &protocol::Limits::default())
+        .ok()
+        .and_then(|mut m| m.next())
+        .map(|m| m.address.to_string())
+        .unwrap_or_default()
+}
+
+async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
+    let address = control.address();
+    if control == Control::Status {
+        let pairs = ctx.stats.lock().map(|s| s.pairs()).unwrap_or_default();
+        let mut out = Vec::with_capacity(2048);
+        encode_status_into(&pairs, &mut out);
+        send(ctx, peer, &out).await;
+        return;
+    }
+    let result = match &control {
+        Control::Subscribe { .. } | Control::Unsubscribe { .. } => {
+            let (tx, rx) = oneshot::channel();
+            let cmd = ClientCmd {
+                peer,
+                control: control.clone(),
+                reply: tx,
+            };
+            match ctx.client_tx.send(cmd).await {
+                Ok(()) => wait(rx).await,
+                Err(_) => Err("shutting down".to_string()),
+            }
+        }
+        Control::RecordStart(path) => {
+            ask(ctx, |tx| Cmd::RecordStart(PathBuf::from(path), tx)).await
+        }
+        Control::RecordStop => ask(ctx, Cmd::RecordStop).await,
+        other => ask(ctx, |tx| Cmd::Edit(other.clone(), tx)).await,
+    };
+    match result {
+        Ok(()) => confirm(ctx, peer, &control).await,
+        Err(e) => reply(ctx, peer, address, Err(e)).await,
+    }
+}
+
+/// Sends a command to the processing thread and waits for its answer.
+async fn ask(ctx: &ControlCtx, make: impl FnOnce(Answer) -> Cmd) -> Result<(), String> {
+    let (tx, rx) = oneshot::channel();
+    ctx.cmd_tx
+        .try_send(make(tx))
+        .map_err(|_| "the processing thread is busy or stopped".to_string())?;
+    wait(rx).await
+}
+
+async fn wait(rx: oneshot::Receiver<Result<(), String>>) -> Result<(), String> {
+    match tokio::time::timeout(ANSWER_TIMEOUT, rx).await {
+        Ok(Ok(r)) => r,
+        Ok(Err(_)) => Err("shutting down".to_string()),
+        Err(_) => Err("no answer from the processing thread".to_string()),
+    }
+}
+
+/// Loads and validates a model on a blocking thread, then swaps it in at a frame boundary. A
+/// bad file leaves the old model running.
+async fn reload(ctx: &ControlCtx, path: PathBuf) -> Result<(), String> {
+    let model = super::server::load_model(path.clone())
+        .await
+        .map_err(|e| format!("{e:#}"))?;
+    ask(ctx, |tx| Cmd::SetModel(Arc::new(model), tx)).await?;
+    if let Ok(mut p) = ctx.model_path.lock() {
+        *p = path.clone();
+    }
+    tracing::info!(path = %path.display(), "model swapped in");
+    Ok(())
+}
+
+async fn confirm(ctx: &ControlCtx, peer: SocketAddr, control: &Control) {
+    let mut out = Vec::with_capacity(256);
+    encode_confirm_into(control, &mut out);
+    send(ctx, peer, &out).await;
+}
+
+/// Sends the error reply of a refused message (`Ok` sends nothing).
+async fn reply(ctx: &ControlCtx, peer: SocketAddr, address: &str, r: Result<(), String>) {
+    let Err(e) = r else { return };
+    tracing::debug!(%peer, address, error = %e, "control refused");
+    let mut out = Vec::with_capacity(256);
+    encode_error_into(address, &e, &mut out);
+    send(ctx, peer, &out).await;
+}
+
+async fn send(ctx: &ControlCtx, peer: SocketAddr, bytes: &[u8]) {
+    if let Err(e) = ctx.socket.send_to(bytes, peer).await {
+        tracing::debug!(%peer, error = %e, "control reply not sent");
+    }
+}
+
+/// Reloads the last model file on SIGHUP until shutdown.
+pub(crate) async fn reload_on_sighup(ctx: ControlCtx, shutdown: CancellationToken) {
+    #[cfg(unix)]
+    {
+        use tokio::signal::unix::{signal, SignalKind};
+        let Ok(mut hup) = signal(SignalKind::hangup()) else {
+            tracing::warn!("cannot listen for SIGHUP; reload with /model/load");
+            return;
+        };
+        loop {
+            tokio::select! {
+                () = shutdown.cancelled() => break,
+                _ = hup.recv() => {
+                    let path = ctx.model_path.lock().map(|p| p.clone()).ok();
+                    let Some(path) = path else { continue };
+                    match reload(&ctx, path).await {
+                        Ok(()) => {}
+                        Err(e) => tracing::warn!(error = %e, "SIGHUP reload failed, old model kept"),
+                    }
+                }
+            }
+        }
+    }
+    #[cfg(not(unix))]
+    shutdown.cancelled().await;
+}

@@ -1,0 +1,384 @@
+//! The live emotion edit of one stream, sans-IO: it advances on a frame clock (`dt_s` per frame,
+//! from frame numbers and the model rate), never on the wall clock, so a test or an offline run
+//! sees exactly what the daemon does.
+//!
+//! The edit, for the emotion component `E`:
+//! `u_E' = u_E + amount · (level[target] − lowpass(u_E))`, with a one-pole low-pass whose time
+//! constant is the window (default 1 s): the slow emotion drift is moved, the fast speech motion
+//! of the same component is kept. Raw alpha (`u_k + alpha_k`), gains (`g_k · u_k`) and bypass
+//! complete it; with amount 0 and no bypass the result is bit-for-bit `FrameEdit::apply`
+//! (`u · g + alpha`), so the live and offline edits agree.
+//!
+//! Every setting glides from its current value to the new one over the ramp (default 0.25 s)
+//! on a smoothstep curve (`3t² − 2t³`): value and slope are continuous at both ends, so no
+//! setting change makes a step (a "pop") in the markers. A change during a glide starts from
+//! where the glide is.
+
+/// Default ramp of a new setting (seconds).
+pub const DEFAULT_RAMP_S: f32 = 0.25;
+/// Default low-pass window of the emotion component (seconds).
+pub const DEFAULT_LOWPASS_S: f32 = 1.0;
+
+/// One value gliding towards a goal on a smoothstep curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Glide {
+    from: f32,
+    to: f32,
+    elapsed_s: f32,
+    duration_s: f32,
+}
+
+impl Glide {
+    /// A settled value.
+    pub fn settled(value: f32) -> Glide {
+        Glide {
+            from: value,
+            to: value,
+            elapsed_s: 0.0,
+            duration_s: 0.0,
+        }
+    }
+
+    /// The current value.
+    pub fn value(&self) -> f32 {
+        // A hair of slack so that n frames of dt reach an n·dt ramp despite f32 rounding.
+        if self.elapsed_s >= self.duration_s * (1.0 - 1e-5) {
+            return self.to;
+        }
+        let t = self.elapsed_s / self.duration_s;
+        self.from + (self.to - self.from) * (t * t * (3.0 - 2.0 * t))
+    }
+
+    /// The goal.
+    pub fn goal(&self) -> f32 {
+        self.to
+    }
+
+    /// Starts gliding from the current value to `to` over `duration_s` (0 = at once).
+    pub fn set(&mut self, to: f32, duration_s: f32) {
+        self.from = self.value();
+        self.to = to;
+        self.elapsed_s = 0.0;
+        self.duration_s = duration_s.max(0.0);
+    }
+
+    /// Advances the glide by `dt_s`.
+    pub fn advance(&mut self, dt_s: f32) {
+        if self.elapsed_s < self.duration_s {
+            self.elapsed_s += dt_s;
+        }
+    }
+
+    /// The glide has reached its goal.
+    pub fn is_settled(&self) -> bool {
+        self.elapsed_s >= self.duration_s
+    }
+}
+
+/// Why an edit setting was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EditRefused {
+    /// Component index past the model's.
+    #[error("component {index} is out of range, the model has {components}")]
+    Component {
+        /// Index received.
+        index: u32,
+        /// Components of the model.
+        components: usize,
+    },
+    /// The model has no emotion component (run `emoshift analyze --write-model`).
+    #[error("the model has no emotion component")]
+    NoEmotion,
+    /// The model has no level for that emotion.
+    #[error("unknown emotion {name:?}")]
+    UnknownEmotion {
+        /// Name received.
+        name: String,
+    },
+}
+
+/// The live edit of one stream. Call order per frame: [`EditState::apply`] with the frame's
+/// `dt_s`; settings (`set_*`) between frames.
+#[derive(Debug, Clone)]
+pub struct EditState {
+    emotion: Option<usize>,
+    target: String,
+    level: Glide,
+    amount: Glide,
+    alpha: Vec<Glide>,
+    gains: Vec<Glide>,
+    wet: Glide,
+    ramp_s: f32,
+    lowpass_s: f32,
+    lowpass: Option<f32>,
+    raw: Vec<f32>,
+}
+
+impl EditState {
+    /// An identity edit for `components` components; `emotion` is the emotion component.
+    pub fn new(components: usize, emotion: Option<usize>, lowpass_s: f32) -> EditState {
+        EditState {
+            emotion,
+            target: String::with_capacity(32),
+            level: Glide::settled(0.0),
+            amount: Glide::settled(0.0),
+            alpha: vec![Glide::settled(0.0); components],
+            gains: vec![Glide::settled(1.0); components],
+            wet: Glide::settled(1.0),
+            ramp_s: DEFAULT_RAMP_S,
+            lowpass_s: lowpass_s.max(0.0),
+            lowpass: None,
+            raw: vec![0.0; components],
+        }
+    }
+
+    /// The target emotion (empty before one is set).
+    pub fn target(&self) -> &str {
+        &self.target
+    }
+
+    /// The amount now (mid-glide values included).
+    pub fn amount(&self) -> f32 {
+        self.amount.value()
+    }
+
+    /// Ramp used by the next settings.
+    pub fn set_ramp(&mut self, ramp_s: f32) {
+        self.ramp_s = ramp_s.max(0.0);
+    }
+
+    /// Sets the target emotion, whose `level` the caller looked up in the model.
+    ///
+    /// # Errors
+    /// [`EditRefused::NoEmotion`] when the model has no emotion component.
+    pub fn set_target(&mut self, name: &str, level: f32) -> Result<(), EditRefused> {
+        if self.emotion.is_none() {
+            return Err(EditRefused::NoEmotion);
+        }
+        self.target.clear();
+        self.target.push_str(name);
+        self.level.set(level, self.ramp_s);
+        Ok(())
+    }
+
+    /// Sets the amount.
+    ///
+    /// # Errors
+    /// [`EditRefused::NoEmotion`] when the model has no emotion component.
+    pub fn set_amount(&mut self, amount: f32) -> Result<(), EditRefused> {
+        if self.emotion.is_none() {
+            return Err(EditRefused::NoEmotion);
+        }
+        self.amount.set(amount, self.ramp_s);
+        Ok(())
+    }
+
+    /// Sets the raw translate of component `k`.
+    ///
+    /// # Errors
+    /// [`EditRefused::Component`] past the model's components.
+    pub fn set_alpha(&mut self, k: u32, value: f32) -> Result<(), EditRefused> {
+        let ramp = self.ramp_s;
+        self.slot(k, |s| &mut s.alpha)?.set(value, ramp);
+        Ok(())
+    }
+
+    /// Sets the gain of component `k`.
+    ///
+    /// # Errors
+    /// [`EditRefused::Component`] past the model's components.
+    pub fn set_gain(&mut self, k: u32, gain: f32) -> Result<(), EditRefused> {
+        let ramp = self.ramp_s;
+        self.slot(k, |s| &mut s.gains)?.set(gain, ramp);
+        Ok(())
+    }
+
+    /// Turns the edit off (frames pass through unedited) or back on, gliding.
+    pub fn set_bypass(&mut self, bypass: bool) {
+        self.wet.set(if bypass { 0.0 } else { 1.0 }, self.ramp_s);
+    }
+
+    fn slot(
+        &mut self,
+        k: u32,
+        pick: impl FnOnce(&mut EditState) -> &mut Vec<Glide>,
+    ) -> Result<&mut Glide, EditRefused> {
+        let components = self.raw.len();
+        pick(self)
+            .get_mut(k as usize)
+            .ok_or(EditRefused::Component {
+                index: k,
+                components,
+            })
+    }
+
+    /// Edits one frame's components in place and advances every glide and the low-pass by
+    /// `dt_s`. Allocation-free. `u` must have the model's component count (shorter or longer
+    /// slices are edited over the common length).
+    pub fn apply(&mut self, dt_s: f32, u: &mut [f32]) {
+        let wet = self.wet.value();
+        if wet < 1.0 {
+            let n = u.len().min(self.raw.len());
+            self.raw[..n].copy_from_slice(&u[..n]);
+        }
+        for ((ui, g), a) in u.iter_mut().zip(&self.gains).zip(&self.alpha) {
+            *ui = *ui * g.value() + a.value();
+        }
+        if let Some(k) = self.emotion.filter(|&k| k < u.len()) {
+            let raw = if wet < 1.0 { self.raw[k] } else { u[k] };
+            let lp = self.update_lowpass(dt_s, raw);
+            let amount = self.amount.value();
+            if amount != 0.0 {
+                u[k] += amount * (self.level.value() - lp);
+            }
+        }
+        if wet < 1.0 {
+            for (ui, r) in u.iter_mut().zip(&self.raw) {
+                *ui = r + wet * (*ui - r);
+            }
+        }
+        self.advance(dt_s);
+    }
+
+    /// One-pole low-pass of the emotion component (before the edit), started at its first value.
+    fn update_lowpass(&mut self, dt_s: f32, x: f32) -> f32 {
+        let y = match self.lowpass {
+            None => x,
+            Some(y) if self.lowpass_s <= 0.0 => {
+                let _ = y;
+                x
+            }
+            Some(y) => y + (x - y) * (dt_s / (self.lowpass_s + dt_s)),
+        };
+        self.lowpass = Some(y);
+        y
+    }
+
+    fn advance(&mut self, dt_s: f32) {
+        self.level.advance(dt_s);
+        self.amount.advance(dt_s);
+        self.wet.advance(dt_s);
+        for g in self.alpha.iter_mut().chain(self.gains.iter_mut()) {
+            g.advance(dt_s);
+        }
+    }
+
+    /// Forgets the low-pass history (a stream restarted).
+    pub fn reset_lowpass(&mut self) {
+        self.lowpass = None;
+    }
+
+    /// Copies every setting (goals, settled) of `other` into `self`, for a new stream or a
+    /// reloaded model; components beyond the shorter of the two keep their identity values.
+    pub fn copy_settings(&mut self, other: &EditState) {
+        self.ramp_s = other.ramp_s;
+        self.target.clear();
+        self.target.push_str(&other.target);
+        if self.emotion.is_some() && other.emotion.is_some() {
+            self.level = Glide::settled(other.level.goal());
+            self.amount = Glide::settled(other.amount.goal());
+        }
+        self.wet = Glide::settled(other.wet.goal());
+        for (a, b) in self.alpha.iter_mut().zip(&other.alpha) {
+            *a = Glide::settled(b.goal());
+        }
+        for (a, b) in self.gains.iter_mut().zip(&other.gains) {
+            *a = Glide::settled(b.goal());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DT: f32 = 1.0 / 120.0;
+
+    #[test]
+    fn settled_alpha_and_gain_equal_frame_edit_bit_for_bit() {
+        let mut e = EditState::new(3, None, 1.0);
+        e.set_ramp(0.0);
+        e.set_alpha(1, 1.5).expect("in range");
+        e.set_gain(2, 0.5).expect("in range");
+        let mut fe = ica_core::edit::FrameEdit::identity(3);
+        fe.set_offset(1, 1.5).expect("in range");
+        fe.set_gain(2, 0.5).expect("in range");
+        let mut a = [0.3f32, -0.7, 2.1];
+        let mut b = a;
+        e.apply(DT, &mut a);
+        fe.apply(&mut b).expect("length");
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn a_ramp_glides_monotonically_and_arrives_on_time() {
+        let mut e = EditState::new(2, None, 1.0);
+        e.set_ramp(0.25);
+        e.set_alpha(0, 10.0).expect("in range");
+        let mut prev = 0.0;
+        let mut max_step = 0.0f32;
+        // The frame after the 30th (0.25 s at 120 Hz) sits at the goal.
+        for f in 0..32 {
+            let mut u = [0.0f32, 0.0];
+            e.apply(DT, &mut u);
+            assert!(u[0] >= prev, "frame {f}: {} < {prev}", u[0]);
+            max_step = max_step.max(u[0] - prev);
+            prev = u[0];
+            if f == 0 {
+                assert!(u[0] < 0.01, "the first frame starts at the old value");
+            }
+        }
+        assert_eq!(prev, 10.0);
+        // Smoothstep's steepest slope is 1.5x the linear one: 10 over 30 frames.
+        assert!(max_step < 1.5 * 10.0 / 30.0 + 0.05, "step {max_step}");
+    }
+
+    #[test]
+    fn emotion_edit_moves_the_slow_level_and_keeps_the_fast_motion() {
+        let mut e = EditState::new(1, Some(0), 1.0);
+        e.set_ramp(0.0);
+        e.set_target("happy", 5.0).expect("emotion component");
+        e.set_amount(1.0).expect("emotion component");
+        let mut out = Vec::new();
+        for f in 0..1200 {
+            let speech = (f as f32 * 0.8).sin();
+            let mut u = [1.0 + speech];
+            e.apply(DT, &mut u);
+            out.push((u[0], speech));
+        }
+        // After 10 low-pass windows the slow part sits at the level, the speech rides on it.
+        let tail = &out[1000..];
+        let mean = tail.iter().map(|(v, _)| v).sum::<f32>() / tail.len() as f32;
+        assert!((mean - 5.0).abs() < 0.05, "mean {mean}");
+        let fast = tail
+            .iter()
+            .map(|(v, s)| (v - mean - s).abs())
+            .fold(0.0, f32::max);
+        assert!(fast < 0.1, "speech distorted by {fast}");
+    }
+
+    #[test]
+    fn bypass_glides_back_to_the_input_and_refusals_name_the_value() {
+        let mut e = EditState::new(2, None, 1.0);
+        e.set_ramp(0.0);
+        e.set_alpha(0, 3.0).expect("in range");
+        e.set_ramp(0.1);
+        e.set_bypass(true);
+        let mut u = [1.0f32, 1.0];
+        e.apply(DT, &mut u);
+        assert_eq!(u[0], 4.0, "bypass starts from the edited value");
+        for _ in 0..20 {
+            u = [1.0, 1.0];
+            e.apply(DT, &mut u);
+        }
+        assert_eq!(u, [1.0, 1.0]);
+        assert_eq!(
+            e.set_gain(5, 1.0),
+            Err(EditRefused::Component {
+                index: 5,
+                components: 2
+            })
+        );
+        assert_eq!(e.set_amount(1.0), Err(EditRefused::NoEmotion));
+    }
+}

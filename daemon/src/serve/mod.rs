@@ -1,0 +1,40 @@
+//! `emoshift serve`: the live service.
+//!
+//! - [`config`]: TOML + CLI → one validated [`Config`];
+//! - [`pipeline`]: the sans-IO frame path (decode → map labels → project → edit → resynthesise
+//!   → encode), owning every buffer;
+//! - [`edit_state`]: the live emotion edit (target, amount, ramp, low-pass, alpha, gains,
+//!   bypass) on a frame clock;
+//! - [`streams`]: one stream per source address and layout id, performers;
+//! - [`clients`]: subscribers, sans-IO; [`stats`]: counters and histograms;
+//! - [`record`]: recordings; [`synthetic`]: models and frames for bench and tests;
+//! - `server`, `control`, `sender`: the tasks, the only code that awaits.
+//!
+//! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
+//! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).
+
+pub mod clients;
+pub mod config;
+mod control;
+pub mod edit_state;
+pub mod pipeline;
+pub mod record;
+mod sender;
+mod server;
+pub mod stats;
+pub mod streams;
+pub mod synthetic;
+
+pub use config::Config;
+pub use server::{bind, bind_with, load_model, Bound};
+
+use tokio_util::sync::CancellationToken;
+
+/// Binds, loads the models and serves until `shutdown` is cancelled; then stops receiving,
+/// finishes the frames in flight, closes the recording and returns.
+///
+/// # Errors
+/// A socket that cannot be bound, a model that cannot be loaded, a task that failed.
+pub async fn run(config: Config, shutdown: CancellationToken) -> anyhow::Result<()> {
+    bind(config).await?.run(shutdown).await
+}

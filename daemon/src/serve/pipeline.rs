@@ -1,0 +1,465 @@
+//! The processing path, sans-IO: datagram → decode → map labels → [`FrameProcessor`] (glitch
+//! check, head stabilisation, masked projection) → live edit → resynthesis → encode once per
+//! wanted profile. It owns every buffer (sized at construction and per stream at stream
+//! creation), builds without tokio and is tested without a runtime.
+//!
+//! Call order: [`Pipeline::handle_datagram`] per received datagram, which calls `emit` once
+//! per processed frame with the encoded bytes; [`Pipeline::handle_edit`] and
+//! [`Pipeline::set_model`] between datagrams (a frame boundary).
+
+use std::net::SocketAddr;
+use std::sync::Arc;
+
+use ica_core::model::IcaModel;
+use protocol::{
+    decode_frame_into, decode_labels, encode_compact_into, encode_components_into, messages,
+    Address, Control, FlatSplit, FrameBuf, LayoutBook, LayoutChange, Limits, Profile,
+    ETHERNET_PAYLOAD,
+};
+
+use super::edit_state::EditRefused;
+use super::stats::Counters;
+use super::streams::{Order, Performer, Stream, StreamKey, Streams};
+
+/// Sources tracked for labels, and streams, at most (bounds memory against spoofed senders).
+pub const MAX_SOURCES: usize = 64;
+
+/// Profiles to encode, as a bit set (`1 << profile index` in [`Profile::ALL`]).
+pub type ProfileMask = u8;
+
+/// The bit of one profile.
+pub fn profile_bit(p: Profile) -> ProfileMask {
+    match p {
+        Profile::Compact => 1,
+        Profile::FlatSplit => 2,
+        Profile::Components => 4,
+    }
+}
+
+/// One processed frame, borrowed from the pipeline's buffers.
+#[derive(Debug)]
+pub struct Emitted<'a> {
+    /// The stream.
+    pub key: StreamKey,
+    /// Frame number.
+    pub frame_number: i32,
+    /// Compact bundle (empty when not wanted).
+    pub compact: &'a [u8],
+    /// Flat-split parts, concatenated; see `part_ends`.
+    pub parts: &'a [u8],
+    /// End offset of each part in `parts`.
+    pub part_ends: &'a [usize],
+    /// Components message (empty when not wanted).
+    pub components: &'a [u8],
+    /// Edited positions in model order (gaps filled by the model).
+    pub xyz: &'a [f32],
+    /// Input positions in model order, and which were missing.
+    pub raw_xyz: &'a [f32],
+    /// Missing flags of the input, model order.
+    pub raw_missing: &'a [bool],
+    /// The stream's model labels.
+    pub labels: &'a [String],
+    /// The stream's model rate.
+    pub rate_hz: f64,
+}
+
+/// Pipeline settings.
+#[derive(Debug, Clone)]
+pub struct PipelineConfig {
+    /// Low-pass window of the emotion edit (seconds).
+    pub lowpass_s: f32,
+    /// Largest frame accepted (markers).
+    pub max_markers: usize,
+}
+
+impl Default for PipelineConfig {
+    fn default() -> Self {
+        PipelineConfig {
+            lowpass_s: super::edit_state::DEFAULT_LOWPASS_S,
+            max_markers: 1_000,
+        }
+    }
+}
+
+/// The processing path. See the module docs for the call order.
+#[derive(Debug)]
+pub struct Pipeline {
+    config: PipelineConfig,
+    model: Arc<IcaModel>,
+    performers: Vec<Performer>,
+    layouts: LayoutBook<SocketAddr>,
+    streams: Streams,
+    /// Settings of the default model's streams, copied into new streams.
+    template: super::edit_state::EditState,
+    limits: Limits,
+    frame_in: FrameBuf,
+    frame_out: FrameBuf,
+    split: FlatSplit,
+    compact: Vec<u8>,
+    components: Vec<u8>,
+    part: Vec<u8>,
+    parts: Vec<u8>,
+    part_ends: Vec<usize>,
+    wanted: ProfileMask,
+    /// Counters, read by the caller after each batch.
+    pub counters: Counters,
+}
+
+impl Pipeline {
+    /// A pipeline over `model`, with optional named performers.
+    pub fn new(model: Arc<IcaModel>, performers: Vec<Performer>, config: PipelineConfig) -> Self {
+        let template = super::edit_state::EditState::new(
+            model.components(),
+            model.emotion().component,
+            config.lowpass_s,
+        );
+        Pipeline {
+            layouts: LayoutBook::new(MAX_SOURCES),
+            streams: Streams::new(MAX_SOURCES),
+            limits: Limits::default(),
+            frame_in: FrameBuf::with_max_markers(config.max_markers),
+            frame_out: FrameBuf::with_max_markers(config.max_markers),
+            split: FlatSplit::new(ETHERNET_PAYLOAD).expect("an Ethernet payload holds a marker"),
+            compact: Vec::with_capacity(ETHERNET_PAYLOAD),
+            components: Vec::with_capacity(ETHERNET_PAYLOAD),
+            part: Vec::with_capacity(ETHERNET_PAYLOAD),
+            parts: Vec::with_capacity(16 * config.max_markers + 4 * ETHERNET_PAYLOAD),
+            part_ends: Vec::with_capacity(config.max_markers),
+            wanted: profile_bit(Profile::Compact),
+            counters: Counters::default(),
+            template,
+            model,
+            performers,
+            config,
+        }
+    }
+
+    /// Sets which profiles are encoded (the subscribers' profiles).
+    pub fn set_wanted(&mut self, wanted: ProfileMask) {
+        self.wanted = wanted;
+    }
+
+    /// The loaded model.
+    pub fn model(&self) -> &Arc<IcaModel> {
+        &self.model
+    }
+
+    /// Streams now.
+    pub fn stream_count(&self) -> usize {
+        self.streams.len()
+    }
+
+    /// Swaps in a new default model at a frame boundary: streams on the default model are
+    /// rebuilt on it, keeping their edit settings; no frame is dropped.
+    pub fn set_model(&mut self, model: Arc<IcaModel>) {
+        let mut template = super::edit_state::EditState::new(
+            model.components(),
+            model.emotion().component,
+            self.config.lowpass_s,
+        );
+        template.copy_settings(&self.template);
+        self.template = template;
+        let old = Arc::clone(&self.model);
+        self.model = model;
+        for (_, stream) in self.streams.iter_mut() {
+            if !Arc::ptr_eq(&stream.model, &old) {
+                continue;
+            }
+            let labels = source_labels(&stream.map, old.labels());
+            if let Ok(mut fresh) = Stream::new(
+                Arc::clone(&self.model),
+                stream.performer,
+                &labels,
+                self.config.lowpass_s,
+            ) {
+                fresh.edit.copy_settings(&stream.edit);
+                fresh.take_last_frame_from(stream);
+                *stream = fresh;
+            }
+        }
+        self.counters.model_swaps += 1;
+    }
+
+    /// Applies an edit control to the template and every stream.
+    ///
+    /// # Errors
+    /// [`EditRefused`] when the default model cannot take it (component out of range, no
+    /// emotion component, unknown emotion); streams of other models skip what they cannot take.
+    pub fn handle_edit(&mut self, control: &Control) -> Result<(), EditRefused> {
+        let model = Arc::clone(&self.model);
+        apply_edit(&mut self.template, &model, control)?;
+        for (_, stream) in self.streams.iter_mut() {
+            let m = Arc::clone(&stream.model);
+            let _ = apply_edit(&mut stream.edit, &m, control);
+        }
+        Ok(())
+    }
+
+    /// Handles one received datagram; `emit` is called once per processed frame.
+    pub fn handle_datagram(
+        &mut self,
+        peer: SocketAddr,
+        datagram: &[u8],
+        emit: &mut dyn FnMut(&Emitted<'_>),
+    ) {
+        let msgs = match messages(datagram, &self.limits) {
+            Ok(m) => m,
+            Err(e) => {
+                self.counters.bad_packet(e.kind());
+                return;
+            }
+        };
+        for msg in msgs {
+            match Address::parse(msg.address) {
+                Some(Address::Frame) => self.handle_frame(peer, msg.bytes, emit),
+                Some(Address::Labels) => self.handle_labels(peer, msg.bytes),
+                _ => self
+                    .counters
+                    .bad_packet(protocol::DecodeErrorKind::UnknownAddress),
+            }
+        }
+    }
+
+    fn handle_labels(&mut self, peer: SocketAddr, bytes: &[u8]) {
+        match decode_labels(bytes) {
+            Ok(labels) => {
+                let id = labels.layout_id;
+                self.counters.labels_in += 1;
+                if let LayoutChange::Replaced | LayoutChange::Added =
+                    self.layouts.handle_labels(&peer, labels)
+                {
+                    self.streams.forget(peer, id);
+                }
+            }
+            Err(e) => self.counters.bad_packet(e.kind()),
+        }
+    }
+
+    fn handle_frame(&mut self, peer: SocketAddr, bytes: &[u8], emit: &mut dyn FnMut(&Emitted<'_>)) {
+        let header = match decode_frame_into(bytes, &mut self.frame_in) {
+            Ok(h) => h,
+            Err(e) => return self.counters.bad_packet(e.kind()),
+        };
+        self.counters.frames_in += 1;
+        let Some(key) = self.stream_for(peer, header.marker_count) else {
+            return;
+        };
+        let stream = self.streams.get_mut(&key).expect("stream_for created it");
+        let frames = match stream.check_order(header.frame_number) {
+            Order::Next { frames } => frames,
+            Order::Restart => {
+                self.counters.restarts += 1;
+                1
+            }
+            Order::Duplicate => return self.counters.dropped_duplicate += 1,
+            Order::Stale => return self.counters.dropped_stale += 1,
+        };
+        for (i, m) in stream.take_missing.iter_mut().enumerate() {
+            *m = self.frame_in.is_missing(i);
+        }
+        let Stream {
+            map,
+            processor,
+            edit,
+            xyz,
+            missing,
+            u,
+            out,
+            take_missing,
+            model,
+            ..
+        } = stream;
+        map.gather_into(self.frame_in.positions(), take_missing, xyz, missing);
+        self.counters.missing_markers += missing.iter().filter(|&&m| m).count() as u64;
+        let prepared = match processor.project(xyz, missing, u) {
+            Ok(p) => p,
+            Err(_) => return self.counters.frame_errors += 1,
+        };
+        self.counters.glitches += prepared.glitches as u64;
+        let rate = model.rate_hz();
+        let dt = (f64::from(frames.min(rate.max(1.0) as u32)) / rate) as f32;
+        edit.apply(dt, u);
+        if processor
+            .resynthesise(prepared.pose.as_ref(), u, out)
+            .is_err()
+            || self
+                .frame_out
+                .set_frame(header.frame_number, header.capture_time_us, out)
+                .is_err()
+        {
+            return self.counters.frame_errors += 1;
+        }
+        if encode(
+            self.wanted,
+            &self.frame_out,
+            edit,
+            u,
+            &self.split,
+            [
+                &mut self.compact,
+                &mut self.components,
+                &mut self.part,
+                &mut self.parts,
+            ],
+            &mut self.part_ends,
+        )
+        .is_err()
+        {
+            return self.counters.frame_errors += 1;
+        }
+        self.counters.frames_out += 1;
+        emit(&Emitted {
+            key,
+            frame_number: header.frame_number,
+            compact: &self.compact,
+            parts: &self.parts,
+            part_ends: &self.part_ends,
+            components: &self.components,
+            xyz: out,
+            raw_xyz: xyz,
+            raw_missing: missing,
+            labels: model.labels(),
+            rate_hz: rate,
+        });
+    }
+
+    /// The stream of a frame, created on its first frame; counts why a frame has none.
+    fn stream_for(&mut self, peer: SocketAddr, marker_count: usize) -> Option<StreamKey> {
+        let Some(labels) = self.layouts.layout_for(&peer, marker_count) else {
+            self.counters.dropped_no_layout += 1;
+            return None;
+        };
+        let key = StreamKey {
+            source: peer,
+            layout_id: labels.layout_id,
+        };
+        if self.streams.get_mut(&key).is_some() {
+            return Some(key);
+        }
+        let performer = self.performers.iter().position(|p| p.owns(&key));
+        let p = performer.map(|i| &self.performers[i]);
+        let model = p
+            .and_then(|p| p.model.clone())
+            .unwrap_or_else(|| Arc::clone(&self.model));
+        let created = Stream::new(
+            Arc::clone(&model),
+            performer,
+            &labels.names,
+            self.config.lowpass_s,
+        );
+        let Ok(mut stream) = created else {
+            self.counters.dropped_unmatched += 1;
+            return None;
+        };
+        if Arc::ptr_eq(&model, &self.model) {
+            stream.edit.copy_settings(&self.template);
+        }
+        if let Some(p) = p {
+            defaults_of(p, &mut stream);
+        }
+        if !self.streams.insert(key, stream) {
+            self.counters.dropped_unmatched += 1;
+            return None;
+        }
+        Some(key)
+    }
+}
+
+/// A performer's default emotion, set at once (no ramp) on a new stream.
+fn defaults_of(p: &Performer, stream: &mut Stream) {
+    stream.edit.set_ramp(0.0);
+    if let Some(target) = &p.target {
+        let _ = apply_edit(
+            &mut stream.edit,
+            &stream.model,
+            &Control::Target(target.clone()),
+        );
+    }
+    if let Some(amount) = p.amount {
+        let _ = stream.edit.set_amount(amount);
+    }
+    stream.edit.set_ramp(super::edit_state::DEFAULT_RAMP_S);
+}
+
+/// The stream's source labels, rebuilt from its map for a model swap (unmapped source markers
+/// get placeholder names that match nothing).
+fn source_labels(map: &crate::layout::LabelMap, model_labels: &[String]) -> Vec<String> {
+    let n = map
+        .model_to_take
+        .iter()
+        .flatten()
+        .chain(map.extra.iter())
+        .max()
+        .map_or(0, |m| m + 1);
+    let mut labels: Vec<String> = (0..n).map(|i| format!("\u{0}unmapped{i}")).collect();
+    for (i, t) in map.model_to_take.iter().enumerate() {
+        if let Some(t) = t {
+            labels[*t] = model_labels[i].clone();
+        }
+    }
+    labels
+}
+
+/// Applies one edit control to one stream's state, validated against its model.
+pub fn apply_edit(
+    edit: &mut super::edit_state::EditState,
+    model: &IcaModel,
+    control: &Control,
+) -> Result<(), EditRefused> {
+    match control {
+        Control::Target(name) => {
+            let level = model.emotion().levels.get(name).copied();
+            match (model.emotion().component, level) {
+                (None, _) => Err(EditRefused::NoEmotion),
+                (Some(_), None) => Err(EditRefused::UnknownEmotion { name: name.clone() }),
+                (Some(_), Some(level)) => edit.set_target(name, level as f32),
+            }
+        }
+        Control::Amount(a) => edit.set_amount(*a),
+        Control::Ramp(r) => {
+            edit.set_ramp(*r);
+            Ok(())
+        }
+        Control::Alpha { component, value } => edit.set_alpha(*component, *value),
+        Control::Gain { component, gain } => edit.set_gain(*component, *gain),
+        Control::Bypass(b) => {
+            edit.set_bypass(*b);
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Encodes the wanted profiles of one frame into the pipeline's buffers.
+fn encode(
+    wanted: ProfileMask,
+    frame: &FrameBuf,
+    edit: &super::edit_state::EditState,
+    u: &[f32],
+    split: &FlatSplit,
+    [compact, components, part, parts]: [&mut Vec<u8>; 4],
+    part_ends: &mut Vec<usize>,
+) -> Result<(), protocol::EncodeError> {
+    compact.clear();
+    components.clear();
+    parts.clear();
+    part_ends.clear();
+    if wanted & profile_bit(Profile::Compact) != 0 {
+        encode_compact_into(frame, edit.target(), edit.amount(), compact)?;
+    }
+    if wanted & profile_bit(Profile::Components) != 0 {
+        encode_components_into::<&str>(u, &[], components)?;
+    }
+    if wanted & profile_bit(Profile::FlatSplit) != 0 {
+        for i in 0..split.part_count(frame.marker_count()) {
+            split.encode_part_into(frame, i, part);
+            parts.extend_from_slice(part);
+            part_ends.push(parts.len());
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+#[path = "pipeline_tests.rs"]
+pub(crate) mod tests;

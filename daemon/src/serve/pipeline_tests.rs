@@ -1,0 +1,169 @@
+use std::net::SocketAddr;
+use std::sync::Arc;
+
+use ica_core::edit::FrameEdit;
+use protocol::{
+    decode_frame_into, encode_frame_into, encode_labels_into, messages, FrameBuf, Labels,
+};
+
+use super::*;
+use crate::frame::FrameProcessor;
+use crate::serve::synthetic::{frame_into, random_model};
+
+const MARKERS: usize = 12;
+
+fn peer() -> SocketAddr {
+    "127.0.0.1:5000".parse().expect("addr")
+}
+
+fn labels_datagram(model: &IcaModel, reversed: bool) -> Vec<u8> {
+    let mut names = model.labels().to_vec();
+    if reversed {
+        names.reverse();
+    }
+    let mut out = Vec::new();
+    encode_labels_into(
+        &Labels {
+            layout_id: 1,
+            names,
+        },
+        &mut out,
+    )
+    .expect("valid labels");
+    out
+}
+
+fn frame_datagram(xyz: &[f32], n: i32) -> Vec<u8> {
+    let mut buf = FrameBuf::with_max_markers(MARKERS);
+    buf.set_frame(n, i64::from(n) * 8333, xyz).expect("finite");
+    let mut out = Vec::new();
+    encode_frame_into(&buf, &mut out).expect("finite");
+    out
+}
+
+/// Decoded positions of every compact frame the pipeline emits.
+fn run(p: &mut Pipeline, datagrams: &[Vec<u8>]) -> Vec<(i32, Vec<f32>)> {
+    let mut got = Vec::new();
+    for d in datagrams {
+        p.handle_datagram(peer(), d, &mut |e| {
+            let msg = messages(e.compact, &protocol::Limits::default())
+                .expect("well-formed")
+                .next()
+                .expect("the frame comes first");
+            let mut buf = FrameBuf::new();
+            decode_frame_into(msg.bytes, &mut buf).expect("valid frame");
+            got.push((e.frame_number, buf.positions().to_vec()));
+        });
+    }
+    got
+}
+
+#[test]
+fn live_alpha_and_gain_equal_the_offline_frame_path() {
+    let model = Arc::new(random_model(MARKERS, 4, 7));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    for c in [
+        Control::Ramp(0.0),
+        Control::Alpha {
+            component: 1,
+            value: 0.7,
+        },
+        Control::Gain {
+            component: 2,
+            gain: 1.5,
+        },
+    ] {
+        p.handle_edit(&c).expect("valid edit");
+    }
+    let mut xyz = vec![0.0; MARKERS * 3];
+    let mut datagrams = vec![labels_datagram(&model, false)];
+    let mut frames = Vec::new();
+    for f in 0..50 {
+        frame_into(&model, f, &mut xyz);
+        frames.push(xyz.clone());
+        datagrams.push(frame_datagram(&xyz, f as i32));
+    }
+    let got = run(&mut p, &datagrams);
+    assert_eq!(got.len(), 50);
+    let mut proc = FrameProcessor::new(&model);
+    let mut edit = FrameEdit::identity(4);
+    edit.set_offset(1, 0.7).expect("in range");
+    edit.set_gain(2, 1.5).expect("in range");
+    let (mut u, mut out) = (vec![0.0; 4], vec![0.0; MARKERS * 3]);
+    let missing = vec![false; MARKERS];
+    for (f, (n, live)) in got.iter().enumerate() {
+        assert_eq!(*n, f as i32);
+        let prep = proc.project(&frames[f], &missing, &mut u).expect("sizes");
+        edit.apply(&mut u).expect("sizes");
+        proc.resynthesise(prep.pose.as_ref(), &u, &mut out)
+            .expect("sizes");
+        assert_eq!(live, &out, "frame {f}");
+    }
+}
+
+#[test]
+fn labels_map_reordered_sources_and_bad_or_stale_frames_are_counted() {
+    let model = Arc::new(random_model(MARKERS, 4, 3));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let mut xyz = vec![0.0; MARKERS * 3];
+    frame_into(&model, 0, &mut xyz);
+    let mut reversed = xyz.clone();
+    for (i, c) in xyz.chunks_exact(3).enumerate() {
+        let j = MARKERS - 1 - i;
+        reversed[j * 3..j * 3 + 3].copy_from_slice(c);
+    }
+    let datagrams = vec![
+        frame_datagram(&reversed, 0),
+        labels_datagram(&model, true),
+        frame_datagram(&reversed, 1),
+        vec![1, 2, 3],
+        frame_datagram(&reversed, 1),
+        frame_datagram(&reversed, 0),
+        frame_datagram(&reversed, 2),
+    ];
+    let got = run(&mut p, &datagrams);
+    assert_eq!(got.iter().map(|g| g.0).collect::<Vec<_>>(), vec![1, 2]);
+    // Model order out, whatever the source order: the first marker is model marker 0.
+    assert!(
+        (got[0].1[0] - xyz[0]).abs() < 0.5,
+        "{} vs {}",
+        got[0].1[0],
+        xyz[0]
+    );
+    let c = &p.counters;
+    assert_eq!(c.dropped_no_layout, 1);
+    assert_eq!((c.dropped_duplicate, c.dropped_stale), (1, 1));
+    assert_eq!(c.bad_total(), 1);
+    assert_eq!((c.frames_in, c.frames_out), (5, 2));
+}
+
+#[test]
+fn a_model_swap_keeps_the_stream_order_and_settings() {
+    let model = Arc::new(random_model(MARKERS, 4, 3));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    p.handle_edit(&Control::Target("happy".into()))
+        .expect("known");
+    let mut xyz = vec![0.0; MARKERS * 3];
+    frame_into(&model, 0, &mut xyz);
+    assert_eq!(
+        run(
+            &mut p,
+            &[labels_datagram(&model, false), frame_datagram(&xyz, 0)]
+        )
+        .len(),
+        1
+    );
+    p.set_model(Arc::new(random_model(MARKERS, 4, 9)));
+    assert_eq!(run(&mut p, &[frame_datagram(&xyz, 1)]).len(), 1);
+    assert_eq!(p.counters.model_swaps, 1);
+    assert_eq!(
+        p.handle_edit(&Control::Gain {
+            component: 9,
+            gain: 1.0
+        }),
+        Err(EditRefused::Component {
+            index: 9,
+            components: 4
+        })
+    );
+}

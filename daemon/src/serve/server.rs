@@ -1,0 +1,380 @@
+//! The only module that awaits. Tasks:
+//!
+//! - **receive**: frame socket → pooled buffer → bounded crossbeam channel; when full the
+//!   oldest frame is dropped and counted (latest frame wins);
+//! - **processing** (one blocking thread): [`Pipeline`] per frame, control commands between
+//!   frames, recording; the encoded bytes go to the sender in pooled buffers;
+//! - **sender**: the same bytes to every subscriber, each on its own connected socket so an
+//!   ICMP port unreachable surfaces as a send error;
+//! - **control**: decodes control messages and answers them;
+//! - **stats**: logs the counters every few seconds; **SIGHUP** reloads the model.
+//!
+//! Shutdown: the token stops receive and control; the processing thread drains the queue and
+//! closes the recording; the sender drains what is left and ends.
+
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use crossbeam_channel::{Receiver, Sender};
+use ica_core::model::IcaModel;
+use tokio::net::UdpSocket;
+use tokio::sync::{mpsc, oneshot};
+use tokio_util::sync::CancellationToken;
+use tokio_util::task::TaskTracker;
+
+use super::control::{self, Cmd, ControlCtx};
+use super::pipeline::{Emitted, Pipeline, PipelineConfig};
+use super::record::Recording;
+use super::sender::{self, OutFrame};
+use super::stats::Stats;
+use super::streams::Performer;
+use super::Config;
+
+/// Frames processed between two merges of the counters into the shared [`Stats`].
+const STATS_EVERY_FRAMES: u64 = 64;
+/// Pooled buffers kept for received datagrams and encoded frames.
+const POOL: usize = 256;
+
+/// One received datagram.
+#[derive(Debug)]
+pub(crate) struct InFrame {
+    peer: SocketAddr,
+    bytes: Vec<u8>,
+    received: Instant,
+}
+
+/// A server with its sockets bound and its models loaded; [`Bound::run`] serves.
+#[derive(Debug)]
+pub struct Bound {
+    frames: UdpSocket,
+    control: UdpSocket,
+    config: Config,
+    model: Arc<IcaModel>,
+    performers: Vec<Performer>,
+}
+
+/// Loads a model file on a blocking thread.
+///
+/// # Errors
+/// Unreadable or invalid file, named.
+pub async fn load_model(path: std::path::PathBuf) -> Result<IcaModel> {
+    tokio::task::spawn_blocking(move || crate::commands::load_model(&path))
+        .await
+        .context("model loader panicked")?
+}
+
+/// Binds both sockets and loads the models, so that a test learns the addresses before frames
+/// flow (`127.0.0.1:0` gives free ports).
+///
+/// # Errors
+/// A socket that cannot be bound or a model that cannot be loaded.
+pub async fn bind(config: Config) -> Result<Bound> {
+    let model = load_model(config.model.clone()).await?;
+    bind_with(config, model).await
+}
+
+/// [`bind`] with the default model given instead of read from `config.model` (bench, tests).
+///
+/// # Errors
+/// A socket that cannot be bound or a performer model that cannot be loaded.
+pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
+    let model = Arc::new(model);
+    let mut performers = Vec::with_capacity(config.performers.len());
+    for p in &config.performers {
+        let model = match &p.model {
+            Some(path) => Some(Arc::new(load_model(path.clone()).await?)),
+            None => None,
+        };
+        performers.push(Performer {
+            name: p.name.clone(),
+            source: p.source,
+            layout: p.layout,
+            model,
+            target: p.emotion.clone(),
+            amount: p.amount,
+        });
+    }
+    let frames = UdpSocket::bind(config.listen)
+        .await
+        .with_context(|| format!("binding the frame socket {}", config.listen))?;
+    let control = UdpSocket::bind(config.control)
+        .await
+        .with_context(|| format!("binding the control socket {}", config.control))?;
+    Ok(Bound {
+        frames,
+        control,
+        config,
+        model,
+        performers,
+    })
+}
+
+impl Bound {
+    /// The frame socket's address.
+    ///
+    /// # Errors
+    /// The OS cannot tell (not expected for a bound socket).
+    pub fn frame_addr(&self) -> Result<SocketAddr> {
+        Ok(self.frames.local_addr()?)
+    }
+
+    /// The control socket's address.
+    ///
+    /// # Errors
+    /// The OS cannot tell.
+    pub fn control_addr(&self) -> Result<SocketAddr> {
+        Ok(self.control.local_addr()?)
+    }
+
+    /// Serves until `shutdown` is cancelled, then drains and returns.
+    ///
+    /// # Errors
+    /// A task that failed or panicked.
+    pub async fn run(self, shutdown: CancellationToken) -> Result<()> {
+        let tracker = TaskTracker::new();
+        let stats = Arc::new(Mutex::new(Stats::new()));
+        let queue_dropped = Arc::new(AtomicU64::new(0));
+        let wanted = Arc::new(AtomicU8::new(0));
+        let (frame_tx, frame_rx) = crossbeam_channel::bounded::<InFrame>(self.config.queue);
+        let (free_tx, free_rx) = crossbeam_channel::bounded::<Vec<u8>>(POOL);
+        let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Cmd>(64);
+        let (out_tx, out_rx) = mpsc::channel::<OutFrame>(POOL);
+        let (out_free_tx, out_free_rx) = crossbeam_channel::bounded::<OutFrame>(POOL);
+        let (client_tx, client_rx) = mpsc::channel(64);
+
+        let mut pipeline = Pipeline::new(
+            self.model,
+            self.performers,
+            PipelineConfig {
+                lowpass_s: self.config.lowpass_s,
+                ..PipelineConfig::default()
+            },
+        );
+        pipeline.set_wanted(0);
+        let processing = Processing {
+            pipeline,
+            frame_rx: frame_rx.clone(),
+            free_tx,
+            cmd_rx,
+            out_tx,
+            out_free_rx,
+            stats: Arc::clone(&stats),
+            queue_dropped: Arc::clone(&queue_dropped),
+            wanted: Arc::clone(&wanted),
+            recording: None,
+            processed_us: Stats::histogram(),
+        };
+        let processing = tracker.spawn_blocking(move || processing.run());
+
+        let receive = receive(
+            self.frames,
+            frame_tx,
+            frame_rx,
+            free_rx,
+            Arc::clone(&queue_dropped),
+            shutdown.clone(),
+        );
+        tracker.spawn(receive);
+        let sender = sender::Sender::new(&self.config, Arc::clone(&stats), Arc::clone(&wanted))?;
+        tracker.spawn(sender.run(out_rx, out_free_tx, client_rx));
+        let ctx = ControlCtx {
+            socket: Arc::new(self.control),
+            cmd_tx,
+            client_tx,
+            stats: Arc::clone(&stats),
+            model_path: Arc::new(Mutex::new(self.config.model.clone())),
+            tracker: tracker.clone(),
+        };
+        tracker.spawn(control::run(ctx.clone(), shutdown.clone()));
+        tracker.spawn(control::reload_on_sighup(ctx, shutdown.clone()));
+        tracker.spawn(log_stats(
+            stats,
+            self.config.stats_interval,
+            shutdown.clone(),
+        ));
+        tracker.close();
+        let result = processing.await;
+        tracker.wait().await;
+        result.context("processing thread panicked")?
+    }
+}
+
+/// Receive task: datagrams into the bounded queue, latest frame wins.
+async fn receive(
+    socket: UdpSocket,
+    tx: Sender<InFrame>,
+    rx: Receiver<InFrame>,
+    free: Receiver<Vec<u8>>,
+    dropped: Arc<AtomicU64>,
+    shutdown: CancellationToken,
+) {
+    let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
+    loop {
+        let (len, peer) = tokio::select! {
+            () = shutdown.cancelled() => break,
+            r = socket.recv_from(&mut buf) => match r {
+                Ok(r) => r,
+                // ICMP errors and the like on a UDP socket: nothing to do but go on.
+                Err(e) => {
+                    tracing::trace!(error = %e, "frame socket receive error");
+                    continue;
+                }
+            },
+        };
+        let mut bytes = free.try_recv().unwrap_or_default();
+        bytes.clear();
+        bytes.extend_from_slice(&buf[..len]);
+        let mut item = InFrame {
+            peer,
+            bytes,
+            received: Instant::now(),
+        };
+        loop {
+            match tx.try_send(item) {
+                Ok(()) => break,
+                Err(crossbeam_channel::TrySendError::Full(back)) => {
+                    item = back;
+                    if rx.try_recv().is_ok() {
+                        dropped.fetch_add(1, Ordering::Relaxed);
+                    }
+                }
+                Err(crossbeam_channel::TrySendError::Disconnected(_)) => return,
+            }
+        }
+    }
+}
+
+/// The processing thread's state.
+struct Processing {
+    pipeline: Pipeline,
+    frame_rx: Receiver<InFrame>,
+    free_tx: Sender<Vec<u8>>,
+    cmd_rx: Receiver<Cmd>,
+    out_tx: mpsc::Sender<OutFrame>,
+    out_free_rx: Receiver<OutFrame>,
+    stats: Arc<Mutex<Stats>>,
+    queue_dropped: Arc<AtomicU64>,
+    wanted: Arc<AtomicU8>,
+    recording: Option<Recording>,
+    processed_us: hdrhistogram::Histogram<u64>,
+}
+
+impl Processing {
+    fn run(mut self) -> Result<()> {
+        let mut since_merge = 0u64;
+        loop {
+            crossbeam_channel::select! {
+                recv(self.frame_rx) -> msg => match msg {
+                    Ok(frame) => self.process(frame),
+                    Err(_) => break,
+                },
+                recv(self.cmd_rx) -> cmd => if let Ok(cmd) = cmd { self.command(cmd) },
+                default(Duration::from_millis(50)) => self.merge_stats(),
+            }
+            since_merge += 1;
+            if since_merge >= STATS_EVERY_FRAMES {
+                since_merge = 0;
+                self.merge_stats();
+            }
+        }
+        self.merge_stats();
+        if let Some(rec) = self.recording.take() {
+            finish_recording(rec);
+        }
+        Ok(())
+    }
+
+    fn process(&mut self, frame: InFrame) {
+        self.pipeline
+            .set_wanted(self.wanted.load(Ordering::Relaxed));
+        let out_tx = &self.out_tx;
+        let pool = &self.out_free_rx;
+        let recording = &mut self.recording;
+        let received = frame.received;
+        let processed = &mut self.processed_us;
+        let mut send_dropped = 0;
+        self.pipeline
+            .handle_datagram(frame.peer, &frame.bytes, &mut |e: &Emitted<'_>| {
+                if let Some(rec) = recording.as_mut() {
+                    rec.push(e.labels, e.rate_hz, e.frame_number, e.xyz);
+                }
+                let mut out = pool.try_recv().unwrap_or_default();
+                out.fill_from(e, received);
+                Stats::record(processed, out.processed_us());
+                if out_tx.try_send(out).is_err() {
+                    send_dropped += 1;
+                }
+            });
+        if send_dropped > 0 {
+            if let Ok(mut s) = self.stats.lock() {
+                s.send.dropped_send_queue += send_dropped;
+            }
+        }
+        let _ = self.free_tx.try_send(frame.bytes);
+    }
+
+    fn merge_stats(&mut self) {
+        let Ok(mut s) = self.stats.lock() else { return };
+        s.counters = self.pipeline.counters.clone();
+        s.counters.dropped_queue_full = self.queue_dropped.load(Ordering::Relaxed);
+        s.streams = self.pipeline.stream_count() as u64;
+        // Same bounds on both sides, so adding never fails.
+        let _ = s.processed_us.add(&self.processed_us);
+        self.processed_us.reset();
+    }
+
+    fn command(&mut self, cmd: Cmd) {
+        match cmd {
+            Cmd::Edit(control, reply) => {
+                let r = self
+                    .pipeline
+                    .handle_edit(&control)
+                    .map_err(|e| e.to_string());
+                let _ = reply.send(r);
+            }
+            Cmd::SetModel(model, reply) => {
+                self.pipeline.set_model(model);
+                let _ = reply.send(Ok(()));
+            }
+            Cmd::RecordStart(path, reply) => {
+                if let Some(rec) = self.recording.take() {
+                    finish_recording(rec);
+                }
+                let r = Recording::start(&path).map(|rec| self.recording = Some(rec));
+                let _ = reply.send(r.map_err(|e| e.to_string()));
+            }
+            Cmd::RecordStop(reply) => {
+                let r = match self.recording.take() {
+                    Some(rec) => rec.finish().map(|_| ()).map_err(|e| e.to_string()),
+                    None => Err("no recording in progress".to_string()),
+                };
+                let _ = reply.send(r);
+            }
+        }
+    }
+}
+
+fn finish_recording(rec: Recording) {
+    match rec.finish() {
+        Ok(frames) => tracing::info!(frames, "recording closed"),
+        Err(e) => tracing::warn!(error = %e, "recording failed"),
+    }
+}
+
+/// Logs the status every `every` until shutdown.
+async fn log_stats(stats: Arc<Mutex<Stats>>, every: Duration, shutdown: CancellationToken) {
+    let mut tick = tokio::time::interval(every);
+    tick.tick().await;
+    loop {
+        tokio::select! {
+            () = shutdown.cancelled() => break,
+            _ = tick.tick() => if let Ok(s) = stats.lock() { s.log() },
+        }
+    }
+}
+
+/// Replies to a control message's sender: an `oneshot` answer from the processing thread.
+pub(crate) type Answer = oneshot::Sender<Result<(), String>>;

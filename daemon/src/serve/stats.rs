@@ -1,0 +1,190 @@
+//! Counters and per-stage latency histograms (received → processed → sent), logged every few
+//! seconds and sent as the `/status` reply.
+
+use hdrhistogram::Histogram;
+use protocol::DecodeErrorKind;
+
+/// Counters of the processing path, owned by the pipeline (plain integers, no locking).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Frame messages received.
+    pub frames_in: u64,
+    /// Frames processed and encoded.
+    pub frames_out: u64,
+    /// Frames dropped because the queue was full (latest frame wins).
+    pub dropped_queue_full: u64,
+    /// Duplicate frame numbers dropped.
+    pub dropped_duplicate: u64,
+    /// Frames older than the stream's last frame dropped.
+    pub dropped_stale: u64,
+    /// Frames without labels of their size from their source yet.
+    pub dropped_no_layout: u64,
+    /// Frames of a source sharing no marker with the model, or past the stream cap.
+    pub dropped_unmatched: u64,
+    /// Frames the processor refused (an internal invariant; should stay 0).
+    pub frame_errors: u64,
+    /// Labels messages accepted.
+    pub labels_in: u64,
+    /// Model markers missing, summed over frames.
+    pub missing_markers: u64,
+    /// Samples rejected as glitches, summed over frames.
+    pub glitches: u64,
+    /// Sources that restarted (a big backwards jump).
+    pub restarts: u64,
+    /// Models swapped in.
+    pub model_swaps: u64,
+    /// Bad packets by [`DecodeErrorKind`].
+    pub bad: [u64; DecodeErrorKind::ALL.len()],
+}
+
+impl Counters {
+    /// Counts one bad packet.
+    pub fn bad_packet(&mut self, kind: DecodeErrorKind) {
+        self.bad[kind.index()] += 1;
+    }
+
+    /// All bad packets.
+    pub fn bad_total(&self) -> u64 {
+        self.bad.iter().sum()
+    }
+}
+
+/// Counters of the sender task.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SendCounters {
+    /// Datagrams sent.
+    pub datagrams_sent: u64,
+    /// Sends that failed.
+    pub send_errors: u64,
+    /// Subscribers dropped after repeated failures.
+    pub clients_dropped: u64,
+    /// Frames dropped between processing and sending (sender behind).
+    pub dropped_send_queue: u64,
+}
+
+/// Everything `/status` reports, merged from the processing thread and the sender task.
+#[derive(Debug)]
+pub struct Stats {
+    /// Processing counters (latest snapshot).
+    pub counters: Counters,
+    /// Sender counters.
+    pub send: SendCounters,
+    /// Received → processed, microseconds.
+    pub processed_us: Histogram<u64>,
+    /// Processed → sent (to the last subscriber), microseconds.
+    pub sent_us: Histogram<u64>,
+    /// Subscribers now.
+    pub clients: u64,
+    /// Streams now.
+    pub streams: u64,
+}
+
+impl Default for Stats {
+    fn default() -> Self {
+        Stats::new()
+    }
+}
+
+impl Stats {
+    /// An empty latency histogram, 1 µs to 60 s at 3 significant digits.
+    pub fn histogram() -> Histogram<u64> {
+        Histogram::new_with_bounds(1, 60_000_000, 3).expect("constant bounds are valid")
+    }
+
+    /// Empty stats.
+    pub fn new() -> Stats {
+        Stats {
+            counters: Counters::default(),
+            send: SendCounters::default(),
+            processed_us: Stats::histogram(),
+            sent_us: Stats::histogram(),
+            clients: 0,
+            streams: 0,
+        }
+    }
+
+    /// Records one latency in microseconds, saturating at the histogram's top.
+    pub fn record(h: &mut Histogram<u64>, us: u64) {
+        h.saturating_record(us.max(1));
+    }
+
+    /// `(name, value)` pairs in the order `/status/confirm` carries them.
+    pub fn pairs(&self) -> Vec<(String, i64)> {
+        let c = &self.counters;
+        let i = |v: u64| i64::try_from(v).unwrap_or(i64::MAX);
+        let mut out: Vec<(String, i64)> = [
+            ("frames_in", c.frames_in),
+            ("frames_out", c.frames_out),
+            ("frames_dropped", c.dropped_queue_full),
+            ("dropped_duplicate", c.dropped_duplicate),
+            ("dropped_stale", c.dropped_stale),
+            ("dropped_no_layout", c.dropped_no_layout),
+            ("dropped_unmatched", c.dropped_unmatched),
+            ("frame_errors", c.frame_errors),
+            ("labels_in", c.labels_in),
+            ("missing_markers", c.missing_markers),
+            ("glitches", c.glitches),
+            ("restarts", c.restarts),
+            ("model_swaps", c.model_swaps),
+            ("bad_packets", c.bad_total()),
+            ("datagrams_sent", self.send.datagrams_sent),
+            ("send_errors", self.send.send_errors),
+            ("clients_dropped", self.send.clients_dropped),
+            ("dropped_send_queue", self.send.dropped_send_queue),
+            ("clients", self.clients),
+            ("streams", self.streams),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), i(v)))
+        .collect();
+        for kind in DecodeErrorKind::ALL {
+            out.push((format!("bad_{}", kind.as_str()), i(c.bad[kind.index()])));
+        }
+        for (name, h) in [("processed", &self.processed_us), ("sent", &self.sent_us)] {
+            for (q, label) in [(0.5, "p50"), (0.99, "p99"), (0.999, "p999")] {
+                out.push((format!("{name}_{label}_us"), i(h.value_at_quantile(q))));
+            }
+            out.push((format!("{name}_max_us"), i(h.max())));
+        }
+        out
+    }
+
+    /// Logs a one-line summary.
+    pub fn log(&self) {
+        let c = &self.counters;
+        tracing::info!(
+            frames_in = c.frames_in,
+            frames_out = c.frames_out,
+            dropped = c.dropped_queue_full + c.dropped_stale + c.dropped_duplicate,
+            bad_packets = c.bad_total(),
+            missing_markers = c.missing_markers,
+            clients = self.clients,
+            streams = self.streams,
+            processed_p99_us = self.processed_us.value_at_quantile(0.99),
+            sent_p99_us = self.sent_us.value_at_quantile(0.99),
+            "status"
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn status_pairs_name_every_bad_packet_kind_and_the_percentiles() {
+        let mut s = Stats::new();
+        s.counters.frames_in = 3;
+        s.counters.bad_packet(DecodeErrorKind::Truncated);
+        Stats::record(&mut s.processed_us, 40);
+        let pairs = s.pairs();
+        let get = |n: &str| pairs.iter().find(|(k, _)| k == n).map(|(_, v)| *v);
+        assert_eq!(get("frames_in"), Some(3));
+        assert_eq!(get("bad_packets"), Some(1));
+        assert_eq!(
+            get(&format!("bad_{}", DecodeErrorKind::Truncated.as_str())),
+            Some(1)
+        );
+        assert_eq!(get("processed_p50_us"), Some(40));
+    }
+}
