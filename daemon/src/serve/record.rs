@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use replay::Take;
+use replay::record::Recorder;
 
 /// Why a recording could not start or finish.
 #[derive(Debug, thiserror::Error)]
@@ -32,12 +32,17 @@ pub enum RecordError {
     },
 }
 
-/// One recording in progress. Frames arrive in model order with the model's labels.
+/// One recording in progress, written frame by frame by [`Recorder`] (bounded memory, the
+/// file is complete after [`Recording::finish`]). Frames arrive in model order with the
+/// model's labels; the recorder opens on the first frame, which fixes labels, rate and the
+/// first frame number.
 #[derive(Debug)]
 pub struct Recording {
     path: PathBuf,
-    take: Option<Take>,
+    recorder: Option<Recorder>,
     missing: Vec<bool>,
+    frames: usize,
+    failed: bool,
 }
 
 impl Recording {
@@ -62,40 +67,63 @@ impl Recording {
         })?;
         Ok(Recording {
             path: path.to_path_buf(),
-            take: None,
+            recorder: None,
             missing: Vec::new(),
+            frames: 0,
+            failed: false,
         })
     }
 
-    /// Appends one edited frame; the first frame fixes labels, rate and first frame number.
+    /// Appends one edited frame. A write error stops the recording (logged once); the frames
+    /// written so far stay in the file.
     pub fn push(&mut self, labels: &[String], rate_hz: f64, frame_number: i32, xyz: &[f32]) {
-        let take = self
-            .take
-            .get_or_insert_with(|| Take::new(labels.to_vec(), rate_hz, i64::from(frame_number)));
-        if take.n_markers() * 3 != xyz.len() {
+        if self.failed {
             return;
         }
-        self.missing.resize(take.n_markers(), false);
-        take.push_frame(xyz, &self.missing);
+        if self.recorder.is_none() {
+            let first = i64::from(frame_number);
+            match Recorder::create(&self.path, labels.to_vec(), rate_hz, first) {
+                Ok(r) => {
+                    self.missing = vec![false; labels.len()];
+                    self.recorder = Some(r);
+                }
+                Err(e) => return self.fail(&e),
+            }
+        }
+        if xyz.len() != self.missing.len() * 3 {
+            return;
+        }
+        let Some(r) = self.recorder.as_mut() else {
+            return;
+        };
+        match r.push_frame(xyz, &self.missing) {
+            Ok(()) => self.frames += 1,
+            Err(e) => self.fail(&e),
+        }
+    }
+
+    fn fail(&mut self, e: &replay::WriteError) {
+        self.failed = true;
+        tracing::warn!(path = %self.path.display(), error = %e, "recording stopped");
     }
 
     /// Frames recorded so far.
     pub fn frames(&self) -> usize {
-        self.take.as_ref().map_or(0, Take::n_frames)
+        self.frames
     }
 
-    /// Writes the file complete; returns the frames written.
+    /// Closes the file complete; returns the frames written.
     ///
     /// # Errors
-    /// [`RecordError::Write`] when the writer refuses the take.
+    /// [`RecordError::Write`] when the writer cannot finish the file.
     pub fn finish(self) -> Result<usize, RecordError> {
-        let Some(take) = self.take else {
+        let Some(r) = self.recorder else {
             return Ok(0);
         };
-        replay::save(&self.path, &take).map_err(|e| RecordError::Write {
+        let summary = r.finish().map_err(|e| RecordError::Write {
             path: self.path.display().to_string(),
             message: e.to_string(),
         })?;
-        Ok(take.n_frames())
+        Ok(summary.frames as usize)
     }
 }
