@@ -26,7 +26,7 @@ fn whole_frame_path(c: &mut Criterion) {
     pipeline.handle_datagram(peer, &labels, &mut |_| {});
     let mut xyz = vec![0.0; 109 * 3];
     let mut buf = FrameBuf::with_max_markers(109);
-    let datagrams: Vec<Vec<u8>> = (0..120)
+    let mut datagrams: Vec<Vec<u8>> = (0..120)
         .map(|f| {
             frame_into(&model, f, &mut xyz);
             buf.set_frame(0, 0, &xyz).expect("finite");
@@ -38,7 +38,7 @@ fn whole_frame_path(c: &mut Criterion) {
     let mut n: i32 = 0;
     c.bench_function("pipeline 109 markers m=20 compact", |b| {
         b.iter(|| {
-            let d = &mut datagrams[n as usize % 120].clone();
+            let d = &mut datagrams[n as usize % 120];
             // Frame numbers must increase or the stream drops the frame as stale.
             d[24..28].copy_from_slice(&n.to_be_bytes());
             n += 1;
