@@ -5,9 +5,10 @@
 //! variance. The first `m` axes, each scaled to unit variance, whiten the data; FastICA then
 //! only has to find a rotation of them.
 
+mod eigen;
 mod stats;
 
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::DMatrix;
 
 use crate::fit::{FitData, FitError};
 
@@ -120,7 +121,7 @@ pub fn whiten<T: Copy + Into<f64>>(
     let mean = stats::mean(data, &sel);
     let (live, dead) = classify_channels(data, &sel, &mean)?;
     let cov = stats::covariance(data, &sel.used_frames, &live, &mean);
-    let (eigenvalues, axes) = sorted_eigen(cov);
+    let mut eigenvalues = eigen::sorted_eigenvalues(&cov);
     let lmax = eigenvalues.first().copied().unwrap_or(0.0);
     let rank = eigenvalues
         .iter()
@@ -129,7 +130,9 @@ pub fn whiten<T: Copy + Into<f64>>(
     let m = choose_m(components, &eigenvalues, rank)?;
     let total: f64 = eigenvalues.iter().sum();
     let variance_kept = eigenvalues[..m].iter().sum::<f64>() / total;
-    let basis = axes.columns(0, m).into_owned();
+    let (leading, basis) = eigen::leading(&cov, &eigenvalues, m);
+    // The Rayleigh quotients of the kept axes scale them to exactly unit variance.
+    eigenvalues[..m].copy_from_slice(&leading);
     let mut rows = basis.transpose();
     for (i, mut row) in rows.row_iter_mut().enumerate() {
         row /= eigenvalues[i].sqrt();
@@ -167,19 +170,6 @@ fn classify_channels<T: Copy + Into<f64>>(
     Ok((0..data.channels()).partition(|&c| {
         !sel.always_missing[c] && var[c] > DEAD_CHANNEL_RELATIVE_VARIANCE * max_var
     }))
-}
-
-/// Eigen-decomposes a symmetric matrix; returns eigenvalues (clamped at 0) largest first and the
-/// matching unit eigenvectors as columns.
-fn sorted_eigen(cov: DMatrix<f64>) -> (Vec<f64>, DMatrix<f64>) {
-    let eig = SymmetricEigen::new(cov);
-    let mut order: Vec<usize> = (0..eig.eigenvalues.len()).collect();
-    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-    let values = order.iter().map(|&i| eig.eigenvalues[i].max(0.0)).collect();
-    let vectors = DMatrix::from_fn(eig.eigenvectors.nrows(), order.len(), |r, c| {
-        eig.eigenvectors[(r, order[c])]
-    });
-    (values, vectors)
 }
 
 /// Picks `m` from the request and the spectrum.
