@@ -93,6 +93,10 @@ pub struct PreparedData {
     pub residuals_mm: Vec<f64>,
     /// Reference marker labels (empty without stabilisation).
     pub reference: Vec<String>,
+    /// RMS motion (mm) of the candidate reference markers about their mean positions, when a
+    /// reference was chosen; below [`STILL_HEAD_FACTOR`] x the stabilisation residual the head
+    /// counts as still and is not stabilised.
+    pub head_motion_mm: Option<f64>,
 }
 
 impl PreparedData {
@@ -149,7 +153,7 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         .flat_map(|f| f.missing.iter().copied())
         .collect();
     let raw_xyz: Vec<f32> = frames.iter().flat_map(|f| f.xyz.iter().copied()).collect();
-    let reference = reference_markers(&options.head, &labels, &raw_xyz, &raw_missing)?;
+    let mut reference = reference_markers(&options.head, &labels, &raw_xyz, &raw_missing)?;
     let head = match reference.len() {
         0 => None,
         _ => Some(
@@ -163,6 +167,19 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         max_speed_mm_s: None,
         bounds: None,
     };
+    // A head that does not move gains nothing from stabilisation and would only add the pose
+    // estimate's noise (a rigid, correlated jitter) to every marker.
+    let mut head_motion_mm = None;
+    if capture.head.is_some() {
+        let (_, _, _, residuals) = run_prep(&frames, n, rate_hz, &capture)?;
+        let motion = reference_motion_mm(&raw_xyz, &raw_missing, n, &reference);
+        let residual = median(&residuals).unwrap_or(0.0);
+        head_motion_mm = Some(motion);
+        if motion < STILL_HEAD_FACTOR * residual {
+            capture.head = None;
+            reference.clear();
+        }
+    }
     // 2. Speeds and plausible regions measured in head coordinates, then applied.
     let (head_xyz, head_missing, _, _) = run_prep(&frames, n, rate_hz, &capture)?;
     capture.max_speed_mm_s = match options.speed {
@@ -177,6 +194,7 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         run_prep(&frames, n, rate_hz, &capture)?;
     let per_marker = glitches_per_marker(&frames, &marker_missing, n);
     Ok(PreparedData {
+        head_motion_mm,
         glitches_per_marker: per_marker,
         reference: reference.iter().map(|&i| labels[i].clone()).collect(),
         labels,
@@ -270,6 +288,40 @@ fn kept_markers(takes: &[replay::Take], max_share: f64) -> Result<KeptMarkers> {
         );
     }
     Ok((kept, excluded))
+}
+
+/// The head counts as still (and is not stabilised) when its reference markers move less than
+/// this multiple of the stabilisation residual.
+pub const STILL_HEAD_FACTOR: f64 = 3.0;
+
+/// RMS distance (mm) of the reference markers from their mean positions over all frames.
+fn reference_motion_mm(xyz: &[f32], missing: &[bool], n: usize, reference: &[usize]) -> f64 {
+    let frames = missing.len() / n.max(1);
+    let (mut sq, mut count) = (0.0, 0usize);
+    for &m in reference {
+        let present: Vec<usize> = (0..frames).filter(|&f| !missing[f * n + m]).collect();
+        if present.is_empty() {
+            continue;
+        }
+        let mut mean = [0.0f64; 3];
+        for &f in &present {
+            for (a, acc) in mean.iter_mut().enumerate() {
+                *acc += f64::from(xyz[(f * n + m) * 3 + a]) / present.len() as f64;
+            }
+        }
+        for &f in &present {
+            sq += (0..3)
+                .map(|a| (f64::from(xyz[(f * n + m) * 3 + a]) - mean[a]).powi(2))
+                .sum::<f64>();
+            count += 1;
+        }
+    }
+    (sq / count.max(1) as f64).sqrt()
+}
+
+fn median(values: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    quantile(&mut v, 0.5)
 }
 
 /// Radius of a marker's plausible ball: this multiple of the 99th percentile of its distance

@@ -168,7 +168,12 @@ fn print_preparation(data: &PreparedData) -> Result<()> {
             "head stabilised on {}: residual median {median:.2} mm, p95 {p95:.2} mm",
             data.reference.join(", ")
         ),
-        None => crate::out!("no head stabilisation"),
+        None => match data.head_motion_mm {
+            Some(motion) => crate::out!(
+                "no head stabilisation: the reference markers move {motion:.2} mm RMS, too little to gain from it"
+            ),
+            None => crate::out!("no head stabilisation"),
+        },
     }
     Ok(())
 }
