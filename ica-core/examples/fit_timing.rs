@@ -129,11 +129,16 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             .map(|x| x.iterations.to_string())
             .collect();
         let conv: Vec<String> = r.restarts.iter().map(|x| x.converged.to_string()).collect();
+        let refine = r.restarts[r.best_restart]
+            .refinement
+            .as_ref()
+            .map_or(0, |x| x.iterations);
+        let explored = r.restarts[r.best_restart].frames;
         writeln!(
             stdout.lock(),
             "{{\"m\":{m},\"frames\":{},\"channels\":{},\"runs\":{},\"median_s\":{:.6},\
              \"whiten_median_s\":{:.6},\"amari\":{:.6},\"iterations\":[{}],\"converged\":[{}],\
-             \"best_restart\":{}}}",
+             \"best_restart\":{},\"explored_frames\":{},\"refine_iterations\":{}}}",
             args.frames,
             args.channels,
             args.runs,
@@ -142,7 +147,9 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             ai,
             its.join(","),
             conv.join(","),
-            r.best_restart
+            r.best_restart,
+            explored,
+            refine
         )?;
     }
     Ok(())

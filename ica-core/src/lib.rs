@@ -13,7 +13,7 @@ pub mod stabilise;
 pub mod whiten;
 
 pub use fit::{amari_index, FastIcaParams, FitData, FitError, FitOutput};
-pub use report::{RestartReport, TrainReport};
+pub use report::{Refinement, RestartReport, TrainReport};
 
 pub use edit::{EditError, FrameEdit};
 pub use model::{EmotionLevels, IcaModel, ModelError, Role, FORMAT_VERSION};

@@ -13,8 +13,45 @@ pub struct RestartReport {
     pub converged: bool,
     /// The last update's change, `max |1 - |diag(W_new W_old^T)||`.
     pub last_delta: f64,
-    /// Total negentropy approximation of the solution (larger is better).
+    /// Total negentropy approximation of the solution (larger is better), over `frames`.
     pub negentropy: f64,
+    /// Frames the iteration ran on: on long takes the restarts explore an evenly strided
+    /// subsample and only the winner is refined on every used frame (see `refinement`).
+    /// 0 in reports written before this field existed.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub frames: usize,
+    /// For the winning restart of a subsampled fit: the final run on all used frames, started
+    /// from this restart's solution. The kept solution is this one's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<Refinement>,
+}
+
+/// The final FastICA run on all used frames, continuing from the best subsampled restart.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Refinement {
+    /// Frames it ran on (every used frame).
+    pub frames: usize,
+    /// Iterations run.
+    pub iterations: usize,
+    /// Whether the update converged below the tolerance.
+    pub converged: bool,
+    /// The last update's change, `max |1 - |diag(W_new W_old^T)||`.
+    pub last_delta: f64,
+    /// Total negentropy approximation of the kept solution over all used frames.
+    pub negentropy: f64,
+}
+
+impl RestartReport {
+    /// Whether the solution this restart leads to converged: its own run and, when it was
+    /// refined on all frames, the refinement too.
+    pub fn solution_converged(&self) -> bool {
+        self.converged && self.refinement.as_ref().is_none_or(|r| r.converged)
+    }
+}
+
+/// Serde helper: a zero count is the default and is not written.
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// What training did: data used, whitening, and every FastICA restart.

@@ -156,6 +156,11 @@ fn report_describes_the_run() {
     assert_eq!((r.tol, r.max_iter), (1e-5, 700));
     assert_eq!(r.restarts.len(), 3);
     assert!(r.best_restart < 3);
+    // A short take is explored on every frame, with nothing left to refine.
+    assert!(r
+        .restarts
+        .iter()
+        .all(|x| x.frames == 2000 && x.refinement.is_none()));
     let best = r.restarts[r.best_restart].negentropy;
     for x in &r.restarts {
         assert!(x.iterations >= 1 && x.iterations <= 700);
@@ -190,4 +195,32 @@ fn one_and_two_components_fit_through_the_small_matrix_paths() {
             assert!(ai < 0.1, "k={k} {algorithm:?}: amari index {ai}");
         }
     }
+}
+
+#[test]
+fn long_takes_explore_on_a_subsample_and_refine_the_winner_on_every_frame() {
+    let params = FastIcaParams::default().seed(5).restarts(3);
+    let (mix, out) = fit_mixture(6000, 5, 21, params.clone());
+    let r = &out.report;
+    assert_eq!(r.restarts.len(), 3);
+    for (i, x) in r.restarts.iter().enumerate() {
+        // Every 2nd frame of 6000: the restarts explored 3000 frames, not all of them.
+        assert_eq!(x.frames, 3000, "restart {i}");
+        assert_eq!(x.refinement.is_some(), i == r.best_restart, "restart {i}");
+    }
+    let best = &r.restarts[r.best_restart];
+    let refined = best.refinement.as_ref().expect("the winner is refined");
+    assert_eq!(refined.frames, 6000);
+    assert!(refined.iterations >= 1 && refined.converged, "{refined:?}");
+    assert!(best.solution_converged());
+    // The kept solution is the refined one, over every frame: it separates the sources.
+    assert!(best_correlations(&mix.sources, &out)
+        .iter()
+        .all(|&c| c > 0.95));
+    let ai = amari_index(&(&out.unmixing * &mix.mixing)).expect("square");
+    assert!(ai < 0.05, "amari index {ai}");
+    // Deterministic for a seed, subsample and refinement included.
+    let (_, again) = fit_mixture(6000, 5, 21, params);
+    assert_eq!(again.unmixing, out.unmixing);
+    assert_eq!(again.report, out.report);
 }

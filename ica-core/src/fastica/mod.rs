@@ -19,7 +19,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::RestartReport;
+use crate::{Refinement, RestartReport};
 
 /// The update rule.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -80,37 +80,102 @@ pub(crate) struct IcaRun {
     pub best: usize,
 }
 
+/// Restarts explore about this many frames when the take is long enough (see [`run`]).
+pub const EXPLORE_FRAMES: usize = 2500;
+
+/// Column stride of the exploration subsample: 1 (no subsample) for a single restart or a take
+/// shorter than twice [`EXPLORE_FRAMES`].
+fn explore_stride(frames: usize, restarts: usize) -> usize {
+    if restarts < 2 || frames < 2 * EXPLORE_FRAMES {
+        1
+    } else {
+        frames / EXPLORE_FRAMES
+    }
+}
+
 /// Runs `restarts` seeded restarts on `z` (`m x T`) and keeps the best.
 ///
 /// "Best" is the largest total negentropy approximation `sum_i (E G(u_i) - E G(nu))^2` among the
 /// converged restarts; only when none converged does it fall back to all of them, since an
 /// unconverged rotation may stop half-way between two separations. Ties keep the earlier one.
+///
+/// On a long take the restarts only choose the basin: they run on every `k`-th frame (about
+/// [`EXPLORE_FRAMES`] frames), and the winner alone is refined on all frames from its solution,
+/// which takes a few iterations instead of a full run per restart. The winner's report carries
+/// the refinement.
 pub(crate) fn run(z: &DMatrix<f64>, s: Settings) -> IcaRun {
     let (m, frames) = z.shape();
-    let gaussian = s.contrast.gaussian_expectation();
+    let stride = explore_stride(frames, s.restarts);
+    if stride == 1 {
+        return explore(z, s);
+    }
+    let cols: Vec<usize> = (0..frames).step_by(stride).collect();
+    let sub = z.select_columns(&cols);
+    let mut explored = explore(&sub, s);
+    let mut ws = symmetric::Workspace::new(m, frames);
+    let out = solve(z, explored.w.clone(), s, &mut ws);
+    let negentropy = negentropy(&out.w, z, s.contrast, &mut ws.gy);
+    explored.restarts[explored.best].refinement = Some(Refinement {
+        frames,
+        iterations: out.iterations,
+        converged: out.converged,
+        last_delta: out.last_delta,
+        negentropy,
+    });
+    IcaRun {
+        w: out.w,
+        sources: ws.gy,
+        restarts: explored.restarts,
+        best: explored.best,
+    }
+}
+
+/// One run of the configured update from `w0`.
+fn solve(
+    z: &DMatrix<f64>,
+    w0: DMatrix<f64>,
+    s: Settings,
+    ws: &mut symmetric::Workspace,
+) -> Outcome {
+    match s.algorithm {
+        Algorithm::Symmetric => symmetric::run(z, w0, s.contrast, s.tol, s.max_iter, ws),
+        Algorithm::Deflation => deflation::run(z, &w0, s.contrast, s.tol, s.max_iter),
+    }
+}
+
+/// Total negentropy of the sources `W z`, which are left in `gy` (`T x m`).
+fn negentropy(
+    w: &DMatrix<f64>,
+    z: &DMatrix<f64>,
+    contrast: Contrast,
+    gy: &mut DMatrix<f64>,
+) -> f64 {
+    let gaussian = contrast.gaussian_expectation();
+    symmetric::sources_into(z, w, gy);
+    gy.as_slice()
+        .chunks_exact(z.ncols())
+        .map(|col| contrast.negentropy(col, gaussian))
+        .sum()
+}
+
+/// The seeded restarts on `z`, each from its own random start; keeps the best (see [`run`]).
+fn explore(z: &DMatrix<f64>, s: Settings) -> IcaRun {
+    let (m, frames) = z.shape();
     let mut ws = symmetric::Workspace::new(m, frames);
     let mut best: Option<(usize, f64, DMatrix<f64>, DMatrix<f64>)> = None;
     let mut reports = Vec::with_capacity(s.restarts);
     for k in 0..s.restarts {
         let seed = restart_seed(s.seed, k);
-        let w0 = random_start(m, seed);
-        let out = match s.algorithm {
-            Algorithm::Symmetric => symmetric::run(z, w0, s.contrast, s.tol, s.max_iter, &mut ws),
-            Algorithm::Deflation => deflation::run(z, &w0, s.contrast, s.tol, s.max_iter),
-        };
-        symmetric::sources_into(z, &out.w, &mut ws.gy);
-        let negentropy: f64 = ws
-            .gy
-            .as_slice()
-            .chunks_exact(frames)
-            .map(|col| s.contrast.negentropy(col, gaussian))
-            .sum();
+        let out = solve(z, random_start(m, seed), s, &mut ws);
+        let negentropy = negentropy(&out.w, z, s.contrast, &mut ws.gy);
         reports.push(RestartReport {
             seed,
             iterations: out.iterations,
             converged: out.converged,
             last_delta: out.last_delta,
             negentropy,
+            frames,
+            refinement: None,
         });
         let better = match &best {
             None => true,
