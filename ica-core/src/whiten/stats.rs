@@ -110,12 +110,21 @@ fn for_each_chunk<T: Copy + Into<f64>>(
     mut each: impl FnMut(usize, &[f64], DMatrixView<'_, f64>),
 ) {
     let nl = live.len();
+    // With every channel live (the usual case) a frame is converted as one contiguous run,
+    // which vectorises; the indexed gather below does not.
+    let all_live = nl == data.channels();
     let mut buf = vec![0.0f64; nl * CHUNK_FRAMES];
     for (k, frames) in used.chunks(CHUNK_FRAMES).enumerate() {
         for (col, &f) in buf.chunks_exact_mut(nl).zip(frames) {
             let values = data.frame(f);
-            for (dst, &c) in col.iter_mut().zip(live) {
-                *dst = values[c].into() - mean[c];
+            if all_live {
+                for ((dst, &v), &mu) in col.iter_mut().zip(values).zip(mean) {
+                    *dst = v.into() - mu;
+                }
+            } else {
+                for (dst, &c) in col.iter_mut().zip(live) {
+                    *dst = values[c].into() - mean[c];
+                }
             }
         }
         let raw = &buf[..nl * frames.len()];
