@@ -27,7 +27,7 @@ impl Contrast {
     pub(crate) fn apply(self, ys: &mut [f64]) -> f64 {
         match self {
             Contrast::LogCosh => map_sum(ys, |y| {
-                let t = tanh_fast(y);
+                let t = f64::from(tanh_f32(y as f32));
                 (t, 1.0 - t * t)
             }),
             Contrast::Exp => map_sum(ys, |y| {
@@ -140,12 +140,31 @@ pub(crate) fn exp_fast(x: f64) -> f64 {
     p * scale
 }
 
-/// `tanh x` through [`exp_fast`]: `sign(x) (1 - e^{-2|x|}) / (1 + e^{-2|x|})`; absolute error
-/// below 1e-14.
+/// `tanh x` in f32 arithmetic: the rational approximation of Eigen's `generic_fast_tanh_float`
+/// (odd degree-13 over even degree-6, input clamped where f32 tanh is 1), absolute error below
+/// 1e-6.
+///
+/// The non-linearity only has to be accurate well beyond the fit's tolerance (1e-4) and the
+/// sampling noise of the averages it feeds; in f32 it takes a quarter of the f64 exp-based
+/// form's time (four lanes, no range reduction), and it dominated the iteration's cost.
+/// Sums, products with the data and the convergence test stay f64.
 #[inline(always)]
-pub(crate) fn tanh_fast(x: f64) -> f64 {
-    let e = exp_fast(-2.0 * x.abs());
-    ((1.0 - e) / (1.0 + e)).copysign(x)
+pub(crate) fn tanh_f32(x: f32) -> f32 {
+    const CLAMP: f32 = 7.905_311;
+    let x = x.clamp(-CLAMP, CLAMP);
+    let x2 = x * x;
+    let mut p = -2.760_768_5e-16_f32;
+    p = p * x2 + 2.000_188e-13;
+    p = p * x2 - 8.604_672e-11;
+    p = p * x2 + 5.122_297e-8;
+    p = p * x2 + 1.485_722_4e-5;
+    p = p * x2 + 6.372_619_3e-4;
+    p = p * x2 + 4.893_524_6e-3;
+    let mut q = 1.198_258_4e-6_f32;
+    q = q * x2 + 1.185_347_1e-4;
+    q = q * x2 + 2.268_434_6e-3;
+    q = q * x2 + 4.893_525e-3;
+    x * p / q
 }
 
 #[cfg(test)]
@@ -153,7 +172,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn fast_exp_and_tanh_match_std() {
+    fn fast_exp_matches_std() {
         for k in 0..20_000 {
             let x = -60.0 + k as f64 * 0.006;
             let e = exp_fast(x.min(0.0));
@@ -162,9 +181,21 @@ mod tests {
                 (e - want).abs() <= 1e-14 * want,
                 "exp({x}) = {e}, want {want}"
             );
-            let t = tanh_fast(x);
-            assert!((t - x.tanh()).abs() < 1e-14, "tanh({x}) = {t}");
         }
+    }
+
+    #[test]
+    fn f32_tanh_is_within_1e6_of_std() {
+        let mut worst = 0.0f64;
+        for k in 0..400_001 {
+            let x = -20.0 + k as f64 * 1e-4;
+            let t = f64::from(tanh_f32(x as f32));
+            worst = worst.max((t - x.tanh()).abs());
+        }
+        assert!(worst < 1e-6, "max |error| {worst}");
+        assert_eq!(tanh_f32(f32::INFINITY), 1.0);
+        assert_eq!(tanh_f32(f32::NEG_INFINITY), -1.0);
+        assert_eq!(tanh_f32(0.0), 0.0);
     }
 
     #[test]
