@@ -119,8 +119,18 @@ pub fn whiten<T: Copy + Into<f64>>(
         });
     }
     let mean = stats::mean(data, &sel);
-    let (live, dead) = classify_channels(data, &sel, &mean)?;
-    let cov = stats::covariance(data, &sel.used_frames, &live, &mean);
+    // The covariance of every channel seen at least once: its diagonal holds the variances that
+    // classify dead channels, which saves a pass over the data.
+    let seen: Vec<usize> = (0..data.channels())
+        .filter(|&c| !sel.always_missing[c])
+        .collect();
+    if seen.is_empty() {
+        return Err(FitError::NoVariance {
+            channels: data.channels(),
+        });
+    }
+    let cov = stats::covariance(data, &sel.used_frames, &seen, &mean);
+    let (live, dead, cov) = classify_channels(data.channels(), &seen, cov)?;
     let mut eigenvalues = eigen::sorted_eigenvalues(&cov);
     let lmax = eigenvalues.first().copied().unwrap_or(0.0);
     let rank = eigenvalues
@@ -152,24 +162,35 @@ pub fn whiten<T: Copy + Into<f64>>(
     })
 }
 
+/// Live channels, dead channels and the live block of the covariance.
+type LiveSplit = (Vec<usize>, Vec<usize>, DMatrix<f64>);
+
 /// Splits channels into live ones and dead ones (missing everywhere, or variance at most
-/// [`DEAD_CHANNEL_RELATIVE_VARIANCE`] of the largest). A constant channel keeps its constant as
-/// mean, so the reconstruction `mean + M u` is right for it; one never seen has mean 0.
-fn classify_channels<T: Copy + Into<f64>>(
-    data: &FitData<'_, T>,
-    sel: &stats::Selection,
-    mean: &[f64],
-) -> Result<(Vec<usize>, Vec<usize>), FitError> {
-    let var = stats::variances(data, sel, mean);
-    let max_var = var.iter().copied().fold(0.0f64, f64::max);
+/// [`DEAD_CHANNEL_RELATIVE_VARIANCE`] of the largest), given the covariance of the `seen`
+/// channels; returns the live channels, the dead ones and the live block of the covariance.
+/// A constant channel keeps its constant as mean, so the reconstruction `mean + M u` is right for
+/// it; one never seen has mean 0.
+fn classify_channels(
+    channels: usize,
+    seen: &[usize],
+    cov: DMatrix<f64>,
+) -> Result<LiveSplit, FitError> {
+    let max_var = cov.diagonal().iter().copied().fold(0.0f64, f64::max);
     if max_var <= 0.0 {
-        return Err(FitError::NoVariance {
-            channels: data.channels(),
-        });
+        return Err(FitError::NoVariance { channels });
     }
-    Ok((0..data.channels()).partition(|&c| {
-        !sel.always_missing[c] && var[c] > DEAD_CHANNEL_RELATIVE_VARIANCE * max_var
-    }))
+    let keep: Vec<usize> = (0..seen.len())
+        .filter(|&i| cov[(i, i)] > DEAD_CHANNEL_RELATIVE_VARIANCE * max_var)
+        .collect();
+    let mut is_live = vec![false; channels];
+    keep.iter().for_each(|&i| is_live[seen[i]] = true);
+    let (live, dead) = (0..channels).partition(|&c| is_live[c]);
+    let cov = if keep.len() == seen.len() {
+        cov
+    } else {
+        cov.select_rows(&keep).select_columns(&keep)
+    };
+    Ok((live, dead, cov))
 }
 
 /// Picks `m` from the request and the spectrum.

@@ -1,5 +1,5 @@
-//! One-pass-per-statistic scans of the training data: which frames count, the mean, per-channel
-//! variance, the covariance and the whitened projection. All sums are in f64.
+//! One-pass-per-statistic scans of the training data: which frames count, the mean, the
+//! covariance (whose diagonal gives the per-channel variances) and the whitened projection. All sums are in f64.
 
 use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
 
@@ -76,26 +76,6 @@ pub(crate) fn mean<T: Copy + Into<f64>>(data: &FitData<'_, T>, sel: &Selection) 
     }
     let n = sel.used_frames.len().max(1) as f64;
     sum.iter_mut().for_each(|s| *s /= n);
-    sum
-}
-
-/// Per-channel unbiased variance over the used frames (two-pass, around the exact mean).
-pub(crate) fn variances<T: Copy + Into<f64>>(
-    data: &FitData<'_, T>,
-    sel: &Selection,
-    mean: &[f64],
-) -> Vec<f64> {
-    let mut sum = vec![0.0f64; data.channels()];
-    for &f in &sel.used_frames {
-        for (c, (s, &v)) in sum.iter_mut().zip(data.frame(f)).enumerate() {
-            if !sel.always_missing[c] {
-                let d = v.into() - mean[c];
-                *s += d * d;
-            }
-        }
-    }
-    let dof = (sel.used_frames.len().max(2) - 1) as f64;
-    sum.iter_mut().for_each(|s| *s /= dof);
     sum
 }
 
