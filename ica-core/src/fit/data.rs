@@ -75,6 +75,11 @@ impl<'a, T: Copy + Into<f64>> FitData<'a, T> {
         &self.samples[frame * self.channels..(frame + 1) * self.channels]
     }
 
+    /// Whether a missing-sample mask was given.
+    pub(crate) fn has_mask(&self) -> bool {
+        self.missing.is_some()
+    }
+
     /// One frame's missing flags, `None` when nothing is missing anywhere.
     pub(crate) fn frame_missing(&self, frame: usize) -> Option<&'a [bool]> {
         self.missing

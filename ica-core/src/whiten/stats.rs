@@ -21,11 +21,32 @@ pub(crate) struct Selection {
     pub used_frames: Vec<usize>,
     /// Channels missing in every frame.
     pub always_missing: Vec<bool>,
+    /// Per-channel sums over the used frames, when the selection pass could form them.
+    sums: Option<Vec<f64>>,
 }
 
 /// Checks every present sample is finite and picks the complete frames.
 pub(crate) fn select<T: Copy + Into<f64>>(data: &FitData<'_, T>) -> Result<Selection, FitError> {
     let (frames, channels) = (data.frames(), data.channels());
+    if !data.has_mask() {
+        // Without a mask every frame is used, and the column sums are finite exactly when every
+        // sample is (f32 or f64 values cannot overflow an f64 sum of any realistic length):
+        // one branch-free, vectorised pass checks the data and forms the mean's sums. Only bad
+        // data takes the scan below, which names the first bad sample.
+        let mut sums = vec![0.0f64; channels];
+        for f in 0..frames {
+            for (s, &v) in sums.iter_mut().zip(data.frame(f)) {
+                *s += v.into();
+            }
+        }
+        if sums.iter().all(|s| s.is_finite()) {
+            return Ok(Selection {
+                used_frames: (0..frames).collect(),
+                always_missing: vec![false; channels],
+                sums: Some(sums),
+            });
+        }
+    }
     let mut missing_count = vec![0usize; channels];
     for f in 0..frames {
         let values = data.frame(f);
@@ -61,11 +82,16 @@ pub(crate) fn select<T: Copy + Into<f64>>(data: &FitData<'_, T>) -> Result<Selec
     Ok(Selection {
         used_frames,
         always_missing,
+        sums: None,
     })
 }
 
 /// Per-channel mean over the used frames (0 for channels missing everywhere).
 pub(crate) fn mean<T: Copy + Into<f64>>(data: &FitData<'_, T>, sel: &Selection) -> Vec<f64> {
+    let n = sel.used_frames.len().max(1) as f64;
+    if let Some(sums) = &sel.sums {
+        return sums.iter().map(|s| s / n).collect();
+    }
     let mut sum = vec![0.0f64; data.channels()];
     for &f in &sel.used_frames {
         for ((s, &v), &dead) in sum.iter_mut().zip(data.frame(f)).zip(&sel.always_missing) {
@@ -74,7 +100,6 @@ pub(crate) fn mean<T: Copy + Into<f64>>(data: &FitData<'_, T>, sel: &Selection) 
             }
         }
     }
-    let n = sel.used_frames.len().max(1) as f64;
     sum.iter_mut().for_each(|s| *s /= n);
     sum
 }
