@@ -271,18 +271,19 @@ fn stress_pattern(rng: &mut impl Rng, n: usize, phrase_break: Option<usize>) -> 
     stress
 }
 
-/// Brow raises lead the accent, peaking at the stressed vowel's onset and decaying over the
-/// next syllable or two: every primary stress, a quarter of the secondary ones. (Peaking on the
-/// vowel centre would tie them to the jaw opening far more than real brows are.)
+/// Brow raises lead the accent: they peak 0.1-0.35 s before the stressed vowel's onset and
+/// decay over the next syllable or two; every primary stress, a sixth of the secondary ones.
+/// (Peaking on the vowel itself would tie them to the jaw opening far more than real brows are,
+/// and no linear method could then tell emphasis from speech.)
 fn brow_events(rng: &mut impl Rng, segs: &[Segment]) -> Vec<BrowEvent> {
     let mut events = Vec::new();
     for seg in segs.iter().filter(|s| s.stress > 0) {
         let amplitude = match seg.stress {
             2 => rng.random_range(0.8..1.2),
-            _ if rng.random_bool(0.25) => rng.random_range(0.4..0.7),
+            _ if rng.random_bool(1.0 / 6.0) => rng.random_range(0.4..0.7),
             _ => continue,
         };
-        let peak_s = seg.start_s;
+        let peak_s = seg.start_s - rng.random_range(0.1..0.35);
         events.push(BrowEvent { peak_s, amplitude });
     }
     events
