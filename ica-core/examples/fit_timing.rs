@@ -77,6 +77,15 @@ fn write_f32(path: &Path, v: &[f32]) -> std::io::Result<()> {
     std::fs::write(path, bytes)
 }
 
+/// CPU time this thread has run, in seconds (Linux `schedstat`; NaN elsewhere). On a loaded
+/// machine it is steadier than wall time, which also counts time spent waiting for a core.
+fn thread_cpu_s() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(f64::NAN, |ns| ns * 1e-9)
+}
+
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -105,16 +114,17 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         write_f64(&args.out.join(format!("mixing_m{m}.f64")), &mix.mixing)?;
         let data = FitData::new(&mix.samples, mix.channels)?;
         let params = FastIcaParams::default().n_components(m).keep_sources(false);
-        let (mut times, mut white_times) = (Vec::new(), Vec::new());
+        let (mut times, mut white_times, mut cpu_times) = (Vec::new(), Vec::new(), Vec::new());
         let mut last = None;
         for _ in 0..args.runs {
             let t0 = Instant::now();
             let w = whiten(&data, Components::Fixed(m))?;
             white_times.push(t0.elapsed().as_secs_f64());
             drop(w);
-            let t0 = Instant::now();
+            let (t0, c0) = (Instant::now(), thread_cpu_s());
             last = Some(params.fit(&data)?);
             times.push(t0.elapsed().as_secs_f64());
+            cpu_times.push(thread_cpu_s() - c0);
         }
         let out = last.ok_or("no run")?;
         write_f64(
@@ -137,12 +147,14 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         writeln!(
             stdout.lock(),
             "{{\"m\":{m},\"frames\":{},\"channels\":{},\"runs\":{},\"median_s\":{:.6},\
+             \"cpu_median_s\":{:.6},\
              \"whiten_median_s\":{:.6},\"amari\":{:.6},\"iterations\":[{}],\"converged\":[{}],\
              \"best_restart\":{},\"explored_frames\":{},\"refine_iterations\":{}}}",
             args.frames,
             args.channels,
             args.runs,
             median(&mut times),
+            median(&mut cpu_times),
             median(&mut white_times),
             ai,
             its.join(","),
