@@ -6,8 +6,12 @@
 //! let data = FitData::new(&mix.samples, mix.channels).expect("whole frames");
 //! let out = FastIcaParams::default().n_components(4).fit(&data).expect("fit");
 //! assert_eq!(out.mixing.shape(), (30, 4));
-//! assert!(out.report.restarts[out.report.best_restart].converged);
+//! assert!(out.report.restarts[out.report.best_restart].solution_converged());
 //! ```
+//!
+//! On long takes (at least twice [`crate::fastica::EXPLORE_FRAMES`] used frames, more than one
+//! restart) the restarts run on an evenly strided subsample and only the winner is refined on all
+//! frames; the winner's [`crate::RestartReport::refinement`] says how that went.
 //!
 //! The model is `x ≈ mean + M u` with `M = P A` (paper eq. 2) in the original channel space and
 //! `u = W (x - mean)` with `W` the whitening followed by the ICA rotation.
