@@ -194,8 +194,13 @@ fn print_summary(model: &IcaModel, takes: usize, seconds: f64) -> Result<()> {
         100.0 * r.variance_kept
     );
     for (i, run) in r.restarts.iter().enumerate() {
+        let on = if run.frames > 0 && run.frames < r.frames_used {
+            format!(" on {} frames", run.frames)
+        } else {
+            String::new()
+        };
         crate::out!(
-            "  restart {i}: {} iterations, {}, negentropy {:.5}{}",
+            "  restart {i}{on}: {} iterations, {}, negentropy {:.5}{}",
             run.iterations,
             if run.converged {
                 "converged"
@@ -205,11 +210,23 @@ fn print_summary(model: &IcaModel, takes: usize, seconds: f64) -> Result<()> {
             run.negentropy,
             if i == r.best_restart { "  <- kept" } else { "" }
         );
+        if let Some(refine) = &run.refinement {
+            crate::out!(
+                "    refined on all {} frames: {} iterations, {}",
+                refine.frames,
+                refine.iterations,
+                if refine.converged {
+                    "converged"
+                } else {
+                    "NOT converged"
+                }
+            );
+        }
     }
     crate::out!(
         "kept restart {} ({}), {seconds:.2} s",
         r.best_restart,
-        if best.converged {
+        if best.solution_converged() {
             "converged"
         } else {
             "not converged: raise --max-iter"
