@@ -69,6 +69,12 @@ pub enum Command {
         emoshift replay take.trc --to 127.0.0.1:9000 --speed 2 --loop --start-frame 120"
     )]
     Replay(ReplayArgs),
+    /// Run the whole chain on an embedded default: synth, train, analyze, serve, replay with an
+    /// emotion sweep, receive, summarise.
+    #[command(
+        after_help = "Examples:\n  emoshift demo\n  emoshift demo --keep demo-out\n  emoshift demo --real"
+    )]
+    Demo(DemoArgs),
 }
 
 /// `emoshift synth`.
@@ -352,4 +358,20 @@ pub enum WireFormat {
     Blob,
     /// `,ih` then 3 floats per marker, all NaN for a missing marker.
     Flat,
+}
+
+/// `emoshift demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Keep everything the demo made in this folder (default: a temporary folder of which only
+    /// the report stays).
+    #[arg(long, value_name = "DIR")]
+    pub keep: Option<PathBuf>,
+    /// Run on the bundled real capture (Facial-Sing) instead of a synthetic session; there are
+    /// no emotion pairs, so there is no sweep.
+    #[arg(long)]
+    pub real: bool,
+    /// Seed of the synthetic session.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
 }

@@ -3,6 +3,7 @@
 mod analyze;
 mod bench;
 mod convert;
+mod demo;
 mod edit;
 mod info;
 mod inspect;
@@ -33,6 +34,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Serve(args) => serve::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Replay(args) => replay::run(&args),
+        Command::Demo(args) => demo::run(&args),
     }
 }
 
