@@ -7,7 +7,11 @@ use clap::Parser;
 
 fn main() -> ExitCode {
     let cli = daemon::cli::Cli::parse();
-    daemon::logging::install();
+    let default_level = match cli.command {
+        daemon::cli::Command::Demo(_) => "warn",
+        _ => "info",
+    };
+    daemon::logging::install(default_level);
     match daemon::commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) if daemon::exit::is_broken_pipe(&err) => ExitCode::SUCCESS,

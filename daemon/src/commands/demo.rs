@@ -362,7 +362,13 @@ fn send_take(
         looping: true,
         ..PacerOptions::default()
     };
-    let total = ((STREAM_S * take.rate_hz).ceil() as usize).max(frames);
+    // With a sweep, loop the take for at least STREAM_S; without one, stream the take (capped).
+    let stream_frames = (STREAM_S * take.rate_hz).ceil() as usize;
+    let total = if sweep.is_some() {
+        stream_frames.max(frames)
+    } else {
+        stream_frames.min(frames)
+    };
     let mut pacer = Pacer::new(take.rate_hz, frames, options)?;
     let mut buf = FrameBuf::with_max_markers(take.n_markers());
     let mut datagram = Vec::with_capacity(protocol::frame_message_len(take.n_markers()));

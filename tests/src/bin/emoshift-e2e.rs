@@ -7,7 +7,7 @@ use clap::Parser;
 
 fn main() -> ExitCode {
     let cli = daemon::cli::Cli::parse();
-    daemon::logging::install();
+    daemon::logging::install("info");
     match daemon::commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) if daemon::exit::is_broken_pipe(&err) => ExitCode::SUCCESS,
