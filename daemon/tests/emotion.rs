@@ -129,6 +129,7 @@ fn analyze_labels_match_the_generator_truth() {
             .iter()
             .map(|c| c["role"].as_str().expect("role").to_string())
             .collect();
+        check_figures(dir.path(), &report);
         let with_role =
             |role: &str| -> Vec<usize> { (0..roles.len()).filter(|&k| roles[k] == role).collect() };
         for (s, info) in truth.mixing.sources.iter().enumerate() {
