@@ -267,6 +267,7 @@ impl Pipeline {
             out,
             take_missing,
             model,
+            vmc,
             ..
         } = stream;
         map.gather_into(self.frame_in.positions(), take_missing, xyz, missing);
@@ -293,7 +294,7 @@ impl Pipeline {
             self.wanted,
             &self.frame_out,
             edit,
-            u,
+            (u, vmc),
             &self.split,
             [
                 &mut self.compact,
@@ -435,7 +436,7 @@ fn encode(
     wanted: ProfileMask,
     frame: &FrameBuf,
     edit: &super::edit_state::EditState,
-    u: &[f32],
+    (u, vmc): (&[f32], &[(String, usize)]),
     split: &FlatSplit,
     [compact, components, part, parts]: [&mut Vec<u8>; 4],
     part_ends: &mut Vec<usize>,
@@ -448,7 +449,7 @@ fn encode(
         encode_compact_into(frame, edit.target(), edit.amount(), compact)?;
     }
     if wanted & profile_bit(Profile::Components) != 0 {
-        encode_components_into::<&str>(u, &[], components)?;
+        encode_components_into(u, vmc, components)?;
     }
     if wanted & profile_bit(Profile::FlatSplit) != 0 {
         for i in 0..split.part_count(frame.marker_count()) {

@@ -90,11 +90,41 @@ pub struct Stream {
     pub u: Vec<f32>,
     /// Edited frame in model order.
     pub out: Vec<f32>,
+    /// VMC blend names of the labelled components (`/VMC/Ext/Blend/Val` of the components
+    /// profile), from the model's roles.
+    pub vmc: Vec<(String, usize)>,
     last_frame: Option<i32>,
     /// Duplicate frame numbers dropped.
     pub duplicates: u64,
     /// Out-of-order (older) frames dropped.
     pub stale: u64,
+}
+
+/// Blend names for the components with a known role: `emotion`, `speech1`, `speech2`, ...,
+/// `eyebrows1`, `eyelids1` (a role held by one component has no number). Unknown and other
+/// components are not named.
+pub fn vmc_names(model: &IcaModel) -> Vec<(String, usize)> {
+    use ica_core::model::Role;
+    let name = |role: Role| match role {
+        Role::Emotion => Some("emotion"),
+        Role::Speech => Some("speech"),
+        Role::Eyebrows => Some("eyebrows"),
+        Role::Eyelids => Some("eyelids"),
+        Role::Unknown | Role::Other => None,
+    };
+    let roles = model.roles();
+    let mut out = Vec::new();
+    for (k, &role) in roles.iter().enumerate() {
+        let Some(base) = name(role) else { continue };
+        let same = roles.iter().filter(|&&r| r == role).count();
+        if same == 1 {
+            out.push((base.to_string(), k));
+        } else {
+            let nth = roles[..=k].iter().filter(|&&r| r == role).count();
+            out.push((format!("{base}{nth}"), k));
+        }
+    }
+    out
 }
 
 impl Stream {
@@ -120,6 +150,7 @@ impl Stream {
             missing: vec![false; n],
             u: vec![0.0; m],
             out: vec![0.0; n * 3],
+            vmc: vmc_names(&model),
             last_frame: None,
             duplicates: 0,
             stale: 0,
@@ -268,5 +299,39 @@ mod tests {
             source: b,
             layout_id: 3
         }));
+    }
+}
+
+#[cfg(test)]
+mod vmc_tests {
+    use ica_core::model::Role;
+
+    use super::vmc_names;
+    use crate::serve::synthetic::random_model;
+
+    #[test]
+    fn labelled_components_get_blend_names() {
+        let mut model = random_model(6, 5, 1);
+        for (k, role) in [
+            Role::Emotion,
+            Role::Speech,
+            Role::Other,
+            Role::Speech,
+            Role::Eyelids,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            model.set_role(k, role).expect("in range");
+        }
+        let names = vmc_names(&model);
+        let expected = [
+            ("emotion", 0),
+            ("speech1", 1),
+            ("speech2", 3),
+            ("eyelids", 4),
+        ];
+        let got: Vec<(&str, usize)> = names.iter().map(|(n, k)| (n.as_str(), *k)).collect();
+        assert_eq!(got, expected);
     }
 }

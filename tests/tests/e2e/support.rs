@@ -235,9 +235,15 @@ impl Receiver {
         while let Ok(Ok(n)) = tokio::time::timeout(wait, self.sock.recv(&mut buf)).await {
             wait = quiet;
             let mut u = vec![0.0; COMPONENTS];
-            let k = protocol::decode_components_into(&buf[..n], &mut u).expect("components");
-            assert_eq!(k, COMPONENTS);
-            got.push(u);
+            // A bundle when the model names components for VMC receivers, else one message.
+            let msgs = protocol::messages(&buf[..n], &protocol::Limits::default()).expect("osc");
+            for m in msgs {
+                if protocol::Address::parse(m.address) == Some(protocol::Address::Components) {
+                    let k = protocol::decode_components_into(m.bytes, &mut u).expect("components");
+                    assert_eq!(k, COMPONENTS);
+                    got.push(u.clone());
+                }
+            }
         }
         got
     }
