@@ -1,25 +1,11 @@
 //! The command line as a user runs it: formats, errors, the offline round trip, and analysis
 //! without emotion pairs.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_emoshift"))
-        .args(args)
-        .output()
-        .expect("emoshift runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = run(args);
-    assert!(
-        out.status.success(),
-        "emoshift {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+use common::{ok, p, run};
 
 /// Runs a command that must fail: exit code 1, one line on stderr naming `needle`, no panic.
 fn fails(args: &[&str], needle: &str) {
@@ -29,10 +15,6 @@ fn fails(args: &[&str], needle: &str) {
     assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
     assert!(err.contains(needle), "{err:?} should name {needle:?}");
     assert!(!err.contains("panicked"), "{err}");
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().expect("utf-8 path")
 }
 
 #[test]

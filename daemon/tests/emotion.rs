@@ -3,22 +3,11 @@
 //! to the generator's happy rendering at the same timing.
 
 use std::path::Path;
-use std::process::Command;
 
 use replay::synth::{load_truth, Synth, SynthParams};
 
-fn emoshift(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_emoshift"))
-        .args(args)
-        .output()
-        .expect("emoshift runs");
-    assert!(
-        out.status.success(),
-        "emoshift {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
+mod common;
+use common::ok as emoshift;
 
 fn params(seed: u64, sentences: usize) -> SynthParams {
     SynthParams {

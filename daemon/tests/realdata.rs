@@ -3,11 +3,13 @@
 //! The fixtures and their SOURCE notes live in `replay/tests/fixtures` and `tests/fixtures`.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use daemon::offline::{self, LoadedTake};
 use daemon::training::{self, HeadChoice, PrepOptions, SpeedLimit};
 use ica_core::model::IcaModel;
+
+mod common;
+use common::{ok as emoshift, p as s};
 
 fn fixture(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
@@ -22,23 +24,6 @@ fn animface() -> Vec<PathBuf> {
         .iter()
         .map(|f| fixture(&format!("tests/fixtures/animface/{f}")))
         .collect()
-}
-
-fn emoshift(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_emoshift"))
-        .args(args)
-        .output()
-        .expect("emoshift runs");
-    assert!(
-        out.status.success(),
-        "emoshift {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
 }
 
 fn load(paths: &[PathBuf]) -> Vec<LoadedTake> {
