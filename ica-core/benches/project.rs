@@ -14,21 +14,7 @@ use std::time::Duration;
 fn model(markers: usize, m: usize, seed: u64) -> IcaModel {
     let n = markers * 3;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let report = TrainReport {
-        frames_total: 1,
-        frames_used: 1,
-        channels: n,
-        dead_channels: vec![],
-        components: m,
-        variance_kept: 0.99,
-        eigenvalues: vec![],
-        contrast: "logcosh".into(),
-        algorithm: "symmetric".into(),
-        tol: 1e-6,
-        max_iter: 100,
-        restarts: vec![],
-        best_restart: 0,
-    };
+    let report = TrainReport::untrained(n, m);
     let mixing = DMatrix::from_fn(n, m, |_, _| rng.random_range(-1.0..1.0));
     let labels = (0..markers).map(|i| format!("m{i}")).collect();
     let mean = (0..n).map(|_| rng.random_range(900.0..1100.0)).collect();

@@ -84,3 +84,25 @@ pub struct TrainReport {
     /// Index into `restarts` of the solution kept.
     pub best_restart: usize,
 }
+
+impl TrainReport {
+    /// The report of a model that was not trained on data: one frame, no restarts. For models
+    /// assembled directly (synthetic models in tests, benches and the daemon's load generator).
+    pub fn untrained(channels: usize, components: usize) -> TrainReport {
+        TrainReport {
+            frames_total: 1,
+            frames_used: 1,
+            channels,
+            dead_channels: vec![],
+            components,
+            variance_kept: 0.99,
+            eigenvalues: vec![],
+            contrast: "logcosh".into(),
+            algorithm: "symmetric".into(),
+            tol: 1e-6,
+            max_iter: 100,
+            restarts: vec![],
+            best_restart: 0,
+        }
+    }
+}

@@ -13,21 +13,7 @@ const M: usize = 20;
 const FRAMES: usize = 10_000;
 
 fn model(rng: &mut ChaCha8Rng) -> IcaModel {
-    let report = TrainReport {
-        frames_total: 1,
-        frames_used: 1,
-        channels: N,
-        dead_channels: vec![],
-        components: M,
-        variance_kept: 0.99,
-        eigenvalues: vec![],
-        contrast: "logcosh".into(),
-        algorithm: "symmetric".into(),
-        tol: 1e-6,
-        max_iter: 100,
-        restarts: vec![],
-        best_restart: 0,
-    };
+    let report = TrainReport::untrained(N, M);
     let mixing = DMatrix::from_fn(N, M, |_, _| rng.random_range(-1.0..1.0));
     let labels = (0..MARKERS).map(|i| format!("m{i}")).collect();
     let mean = (0..N).map(|_| rng.random_range(900.0..1100.0)).collect();

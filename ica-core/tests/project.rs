@@ -12,21 +12,7 @@ const N: usize = MARKERS * 3;
 const M: usize = 20;
 
 fn report(channels: usize, components: usize) -> TrainReport {
-    TrainReport {
-        frames_total: 1,
-        frames_used: 1,
-        channels,
-        dead_channels: vec![],
-        components,
-        variance_kept: 0.99,
-        eigenvalues: vec![],
-        contrast: "logcosh".into(),
-        algorithm: "symmetric".into(),
-        tol: 1e-6,
-        max_iter: 100,
-        restarts: vec![],
-        best_restart: 0,
-    }
+    TrainReport::untrained(channels, components)
 }
 
 fn normal(rng: &mut ChaCha8Rng) -> f64 {

@@ -20,21 +20,7 @@ fn normal(rng: &mut ChaCha8Rng) -> f64 {
 }
 
 fn report() -> TrainReport {
-    TrainReport {
-        frames_total: 1,
-        frames_used: 1,
-        channels: N,
-        dead_channels: vec![],
-        components: M,
-        variance_kept: 0.99,
-        eigenvalues: vec![],
-        contrast: "logcosh".into(),
-        algorithm: "symmetric".into(),
-        tol: 1e-6,
-        max_iter: 100,
-        restarts: vec![],
-        best_restart: 0,
-    }
+    TrainReport::untrained(N, M)
 }
 
 /// Random gaussian mixing (entries ~1 mm), except the speech component, which moves the

@@ -33,21 +33,7 @@ impl Noise {
 pub fn random_model(markers: usize, components: usize, seed: u64) -> IcaModel {
     let mut noise = Noise::new(seed);
     let n = markers * 3;
-    let report = TrainReport {
-        frames_total: 1,
-        frames_used: 1,
-        channels: n,
-        dead_channels: vec![],
-        components,
-        variance_kept: 0.99,
-        eigenvalues: vec![],
-        contrast: "logcosh".into(),
-        algorithm: "symmetric".into(),
-        tol: 1e-6,
-        max_iter: 100,
-        restarts: vec![],
-        best_restart: 0,
-    };
+    let report = TrainReport::untrained(n, components);
     let mixing = DMatrix::from_fn(n, components, |_, _| noise.next_f64() * 5.0);
     let labels = (0..markers).map(|i| format!("m{i}")).collect();
     let mean = (0..n).map(|_| 1000.0 + noise.next_f64() * 100.0).collect();
