@@ -212,6 +212,10 @@ pub struct EditArgs {
     /// How far to move towards --to-emotion: 0 keeps the take, 1 reaches the level.
     #[arg(long, default_value_t = 1.0)]
     pub amount: f64,
+    /// With --to-emotion: edit as the live daemon does, from a causal low-pass of the emotion
+    /// component over this many seconds, instead of the take's mean (same output as `serve`).
+    #[arg(long, value_name = "SECONDS", requires = "to_emotion")]
+    pub lowpass: Option<f64>,
     /// Copy & Replace: take the emotion series of another take (DTW-aligned to this one).
     #[arg(long, value_name = "OTHER")]
     pub replace_emotion_from: Option<PathBuf>,

@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use ica_core::edit::FrameEdit;
 use ica_core::model::IcaModel;
 use ica_core::project::FrameStatus;
 use replay::session::Session;
@@ -178,27 +177,25 @@ pub fn project_take(model: &IcaModel, frames: &ModelFrames) -> Result<Projected>
     })
 }
 
-/// Resynthesises a take from (edited) components, one [`FrameEdit`] per frame produced by `edit`,
-/// putting each frame's head pose back.
+/// Resynthesises a take from its components, each frame's components edited in place by
+/// `edit(frame, u)`, putting each frame's head pose back.
 ///
 /// # Errors
-/// A buffer that does not match the model (an internal invariant).
+/// A buffer that does not match the model (an internal invariant), or `edit`'s own error.
 pub fn resynthesise(
     model: &IcaModel,
     projected: &Projected,
-    mut edit: impl FnMut(usize, &mut FrameEdit),
+    mut edit: impl FnMut(usize, &mut [f32]) -> Result<()>,
 ) -> Result<Vec<f32>> {
     let mut processor = FrameProcessor::new(model);
     let m = projected.m;
     let channels = model.channels();
     let frames = projected.u.len() / m.max(1);
     let mut out = vec![0.0f32; frames * channels];
-    let mut frame_edit = FrameEdit::identity(m);
     let mut u = vec![0.0f32; m];
     for f in 0..frames {
-        edit(f, &mut frame_edit);
         u.copy_from_slice(&projected.u[f * m..(f + 1) * m]);
-        frame_edit.apply(&mut u)?;
+        edit(f, &mut u)?;
         let pose = projected.prepared[f].pose;
         processor.resynthesise(
             pose.as_ref(),

@@ -2,7 +2,8 @@
 //!
 //! - `--translate k=a`, `--gain k=g`: raw edits (section 5, *Translate*).
 //! - `--to-emotion NAME [--amount x]`: translate the emotion component by
-//!   `x · (level[NAME] − mean of the take's emotion component)`.
+//!   `x · (level[NAME] − mean of the take's emotion component)`; with `--lowpass S`, the live
+//!   daemon's edit instead, `x · (level[NAME] − lowpass_S(u_E))`, causal, frame by frame.
 //! - `--replace-emotion-from OTHER`: *Copy & Replace*, the other take's emotion series,
 //!   DTW-aligned to this take on the non-emotion components.
 //! - `--add-emotion-from OTHER --other-model m2.json`: *Copy & Add*, `x = mean₁ + M₁u₁ +
@@ -11,6 +12,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
+use ica_core::edit::FrameEdit;
 use ica_core::model::IcaModel;
 use ica_core::project::Projector;
 use replay::Take;
@@ -18,6 +20,7 @@ use replay::Take;
 use crate::cli::{EditArgs, KeyValue};
 use crate::exit::UsageError;
 use crate::offline::{self, ModelFrames, Projected};
+use crate::serve::edit_state::EditState;
 
 fn check_component(model: &IcaModel, kv: &KeyValue, flag: &str) -> Result<usize> {
     if kv.key >= model.components() {
@@ -103,6 +106,8 @@ struct Plan {
     replace: Option<(usize, Vec<f64>)>,
     /// A second model's component added per frame.
     add: Option<(IcaModel, usize, Vec<f64>)>,
+    /// The live emotion edit (causal low-pass), when `--lowpass` asks for it.
+    live: Option<EditState>,
 }
 
 fn plan(
@@ -117,6 +122,7 @@ fn plan(
         gains: vec![1.0; m],
         replace: None,
         add: None,
+        live: None,
     };
     for kv in &args.translate {
         plan.offsets[check_component(model, kv, "--translate")?] += kv.value as f32;
@@ -137,8 +143,22 @@ fn plan(
         if !(0.0..=1.0).contains(&args.amount) {
             return Err(UsageError(format!("--amount {} is outside 0..1", args.amount)).into());
         }
-        let current = projected.component(k).iter().sum::<f64>() / frames.frames().max(1) as f64;
-        plan.offsets[k] += (args.amount * (level - current)) as f32;
+        match args.lowpass {
+            // The live daemon's edit: towards the level from a causal low-pass of the
+            // component, exactly as `serve` does with a zero ramp.
+            Some(window) => {
+                let mut state = EditState::new(model.components(), Some(k), window as f32);
+                state.set_ramp(0.0);
+                state.set_target(name, *level as f32)?;
+                state.set_amount(args.amount as f32)?;
+                plan.live = Some(state);
+            }
+            None => {
+                let n = frames.frames().max(1) as f64;
+                let current = projected.component(k).iter().sum::<f64>() / n;
+                plan.offsets[k] += (args.amount * (level - current)) as f32;
+            }
+        }
     }
     if let Some(other) = &args.replace_emotion_from {
         let k = emotion_component(model, &args.model)?;
@@ -171,16 +191,23 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
     let map = offline::match_take(&model, &take, &args.file)?;
     let frames = offline::to_model_order(&take, &map);
     let projected = offline::project_take(&model, &frames)?;
-    let plan = plan(args, &model, &projected, &frames)?;
-    let mut edited = offline::resynthesise(&model, &projected, |f, edit| {
-        for k in 0..plan.offsets.len() {
-            // Indices and values were checked when the plan was made.
-            let _ = edit.set_offset(k, plan.offsets[k]);
-            let _ = edit.set_gain(k, plan.gains[k]);
-        }
+    let mut plan = plan(args, &model, &projected, &frames)?;
+    let mut frame_edit = FrameEdit::identity(model.components());
+    for k in 0..plan.offsets.len() {
+        frame_edit.set_offset(k, plan.offsets[k])?;
+        frame_edit.set_gain(k, plan.gains[k])?;
+    }
+    let mut live = plan.live.take();
+    let dt = (1.0 / model.rate_hz()) as f32;
+    let mut edited = offline::resynthesise(&model, &projected, |f, u| {
         if let Some((k, values)) = &plan.replace {
-            let _ = edit.set_override(*k, Some(values[f] as f32));
+            frame_edit.set_override(*k, Some(values[f] as f32))?;
         }
+        frame_edit.apply(u)?;
+        if let Some(state) = live.as_mut() {
+            state.apply(dt, u);
+        }
+        Ok(())
     })?;
     if let Some((model2, k2, values)) = &plan.add {
         let second = Projector::new(model2);

@@ -5,6 +5,8 @@ use std::time::Duration;
 
 use daemon::layout::LabelMap;
 use daemon::offline;
+use daemon::serve::edit_state::{EditState, DEFAULT_LOWPASS_S};
+use ica_core::edit::FrameEdit;
 use protocol::{Control, Profile, Reply};
 
 use super::support::*;
@@ -27,6 +29,8 @@ async fn every_frame_comes_out_edited_exactly_as_offline() {
             component: 2,
             gain: 1.4,
         },
+        Control::Target("happy".into()),
+        Control::Amount(0.7),
     ] {
         assert!(matches!(control.send(&c).await, Reply::Confirm(_)));
     }
@@ -39,7 +43,8 @@ async fn every_frame_comes_out_edited_exactly_as_offline() {
     let got = collect.await.expect("receiver");
     d.stop().await;
 
-    // Offline: the same frames through the code `emoshift edit --translate 1=0.8 --gain 2=1.4` runs.
+    // Offline: the same frames through the code `emoshift edit --translate 1=0.8 --gain 2=1.4
+    // --to-emotion happy --amount 0.7 --lowpass 1` runs.
     let mut take = replay::Take::new(m.model.labels().to_vec(), 120.0, 0);
     for xyz in &frames {
         take.push_frame(xyz, &[false; MARKERS]);
@@ -47,9 +52,25 @@ async fn every_frame_comes_out_edited_exactly_as_offline() {
     let map = LabelMap::new(m.model.labels(), &take.labels).expect("same labels");
     let projected =
         offline::project_take(&m.model, &offline::to_model_order(&take, &map)).expect("project");
-    let edited = offline::resynthesise(&m.model, &projected, |_, e| {
-        e.set_offset(1, 0.8).expect("in range");
-        e.set_gain(2, 1.4).expect("in range");
+    let mut fixed = FrameEdit::identity(m.model.components());
+    fixed.set_offset(1, 0.8).expect("in range");
+    fixed.set_gain(2, 1.4).expect("in range");
+    let level = m.model.emotion().levels["happy"] as f32;
+    let mut emotion = EditState::new(
+        m.model.components(),
+        m.model.emotion().component,
+        DEFAULT_LOWPASS_S,
+    );
+    emotion.set_ramp(0.0);
+    emotion
+        .set_target("happy", level)
+        .expect("emotion component");
+    emotion.set_amount(0.7).expect("finite");
+    let dt = (1.0 / m.model.rate_hz()) as f32;
+    let edited = offline::resynthesise(&m.model, &projected, |_, u| {
+        fixed.apply(u)?;
+        emotion.apply(dt, u);
+        Ok(())
     })
     .expect("resynthesise");
 
