@@ -38,7 +38,7 @@ use std::io::{BufReader, Read, Write};
 
 use self::header::{parse_comment, parse_header, Meta};
 use crate::error::{ReadError, WriteError};
-use crate::trc::text::{self, check_frame_number, parse_time, push_sample, Lines};
+use crate::trc::text::{self, check_frame_number, parse_time, Lines};
 use crate::{Take, Units};
 
 /// Reads a CSV take (values converted to millimetres).
@@ -160,27 +160,8 @@ pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
     writeln!(out, "{line}")?;
     for f in 0..take.n_frames() {
         line.clear();
-        write_row(&mut line, take, f);
+        text::write_row(&mut line, take, f, ',');
         out.write_all(line.as_bytes())?;
     }
     Ok(())
-}
-
-/// Formats frame index `f` as one comma-separated row ending in a newline.
-fn write_row(line: &mut String, take: &Take, f: usize) {
-    use std::fmt::Write as _;
-    let frame = take.first_frame.wrapping_add(f as i64);
-    write!(line, "{frame},{:.6}", take.time_of(f)).expect("writing to a String cannot fail");
-    for m in 0..take.n_markers() {
-        match take.sample(f, m) {
-            Some(p) => {
-                for v in p {
-                    line.push(',');
-                    push_sample(line, v);
-                }
-            }
-            None => line.push_str(",,,"),
-        }
-    }
-    line.push('\n');
 }

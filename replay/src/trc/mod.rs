@@ -40,7 +40,7 @@ pub(crate) mod text;
 use std::io::{BufReader, Read, Write};
 
 use self::header::read_header;
-use self::text::{check_frame_number, parse_time, push_sample, Lines};
+use self::text::{check_frame_number, parse_time, Lines};
 use crate::error::{ReadError, WriteError};
 use crate::Take;
 
@@ -210,27 +210,8 @@ pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
     writeln!(out, "{line}\n")?;
     for f in 0..frames {
         line.clear();
-        write_row(&mut line, take, f);
+        text::write_row(&mut line, take, f, '\t');
         out.write_all(line.as_bytes())?;
     }
     Ok(())
-}
-
-/// Formats frame index `f` as one tab-separated row ending in a newline.
-fn write_row(line: &mut String, take: &Take, f: usize) {
-    use std::fmt::Write as _;
-    let frame = take.first_frame.wrapping_add(f as i64);
-    write!(line, "{frame}\t{:.6}", take.time_of(f)).expect("writing to a String cannot fail");
-    for m in 0..take.n_markers() {
-        match take.sample(f, m) {
-            Some(p) => {
-                for v in p {
-                    line.push('\t');
-                    push_sample(line, v);
-                }
-            }
-            None => line.push_str("\t\t\t"),
-        }
-    }
-    line.push('\n');
 }

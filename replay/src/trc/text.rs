@@ -248,6 +248,30 @@ pub(crate) fn check_labels(
     Ok(())
 }
 
+/// Formats frame index `f` of `take` as one row — frame number, time, then x y z per marker,
+/// empty cells for a missing sample — separated by `sep` and ending in a newline.
+pub(crate) fn write_row(line: &mut String, take: &crate::Take, f: usize, sep: char) {
+    use std::fmt::Write as _;
+    let frame = take.first_frame.wrapping_add(f as i64);
+    write!(line, "{frame}{sep}{:.6}", take.time_of(f)).expect("writing to a String cannot fail");
+    for m in 0..take.n_markers() {
+        match take.sample(f, m) {
+            Some(p) => {
+                for v in p {
+                    line.push(sep);
+                    push_sample(line, v);
+                }
+            }
+            None => {
+                for _ in 0..3 {
+                    line.push(sep);
+                }
+            }
+        }
+    }
+    line.push('\n');
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)] // a failed unwrap is a failed test
 mod tests {
