@@ -6,23 +6,14 @@ use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use daemon::serve::pipeline::{Pipeline, PipelineConfig};
-use daemon::serve::synthetic::{frame_into, random_model};
-use protocol::{encode_frame_into, encode_labels_into, FrameBuf, Labels};
+use daemon::serve::synthetic::{frame_into, labels_datagram, random_model};
+use protocol::{encode_frame_into, FrameBuf};
 
 fn whole_frame_path(c: &mut Criterion) {
     let model = Arc::new(random_model(109, 20, 1));
     let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
     let peer: SocketAddr = "127.0.0.1:9".parse().expect("literal address");
-    let mut labels = Vec::new();
-    let names = model.labels().to_vec();
-    encode_labels_into(
-        &Labels {
-            layout_id: 0,
-            names,
-        },
-        &mut labels,
-    )
-    .expect("valid labels");
+    let labels = labels_datagram(&model).expect("valid labels");
     pipeline.handle_datagram(peer, &labels, &mut |_| {});
     let mut xyz = vec![0.0; 109 * 3];
     let mut buf = FrameBuf::with_max_markers(109);

@@ -16,9 +16,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use hdrhistogram::Histogram;
 use ica_core::model::IcaModel;
-use protocol::{
-    decode_frame_into, encode_frame_into, encode_labels_into, messages, FrameBuf, Labels,
-};
+use protocol::{decode_frame_into, encode_frame_into, messages, FrameBuf};
 use tokio::net::UdpSocket;
 use tokio_util::sync::CancellationToken;
 
@@ -26,7 +24,7 @@ use crate::cli::BenchArgs;
 use crate::serve::config::RawConfig;
 use crate::serve::pipeline::{Pipeline, PipelineConfig};
 use crate::serve::stats::Stats;
-use crate::serve::synthetic::{frame_into, random_model};
+use crate::serve::synthetic::{frame_into, labels_datagram, random_model};
 
 const MARKERS: usize = 109;
 const COMPONENTS: usize = 20;
@@ -230,15 +228,7 @@ async fn send_all(
     let frames = (rate_hz * secs.as_secs_f64()) as u64;
     for p in 0..performers {
         let sock = UdpSocket::bind("127.0.0.1:0").await?;
-        let mut labels = Vec::new();
-        let names = model.labels().to_vec();
-        encode_labels_into(
-            &Labels {
-                layout_id: 0,
-                names,
-            },
-            &mut labels,
-        )?;
+        let labels = labels_datagram(model)?;
         sock.send_to(&labels, to).await?;
         let mut xyz = vec![0.0f32; MARKERS * 3];
         frame_into(model, p, &mut xyz);
@@ -275,15 +265,7 @@ fn processing_rate(model: &IcaModel) -> Result<(f64, f64)> {
     let model = Arc::new(model.clone());
     let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
     let peer: SocketAddr = "127.0.0.1:9".parse()?;
-    let mut d = Vec::new();
-    let names = model.labels().to_vec();
-    encode_labels_into(
-        &Labels {
-            layout_id: 0,
-            names,
-        },
-        &mut d,
-    )?;
+    let mut d = labels_datagram(&model)?;
     pipeline.handle_datagram(peer, &d, &mut |_| {});
     let mut xyz = vec![0.0f32; MARKERS * 3];
     frame_into(&model, 3, &mut xyz);

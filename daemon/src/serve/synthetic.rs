@@ -50,6 +50,20 @@ pub fn random_model(markers: usize, components: usize, seed: u64) -> IcaModel {
     model
 }
 
+/// The `/mocap/labels` datagram announcing `model`'s markers as layout 0, as a source would.
+///
+/// # Errors
+/// A label the wire format cannot carry (a NUL byte).
+pub fn labels_datagram(model: &IcaModel) -> Result<Vec<u8>, protocol::EncodeError> {
+    let mut out = Vec::new();
+    let labels = protocol::Labels {
+        layout_id: 0,
+        names: model.labels().to_vec(),
+    };
+    protocol::encode_labels_into(&labels, &mut out)?;
+    Ok(out)
+}
+
 /// Frame `f` of a synthetic take on `model`: `mean + M·u(f)` with slow and fast sources, in
 /// model marker order, written into `out` (markers × 3).
 pub fn frame_into(model: &IcaModel, f: usize, out: &mut [f32]) {

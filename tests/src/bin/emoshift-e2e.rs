@@ -6,14 +6,5 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
-    let cli = daemon::cli::Cli::parse();
-    daemon::logging::install("info");
-    match daemon::commands::run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(err) if daemon::exit::is_broken_pipe(&err) => ExitCode::SUCCESS,
-        Err(err) => {
-            eprintln!("emoshift: error: {err:#}");
-            ExitCode::from(daemon::exit::code_for(&err))
-        }
-    }
+    daemon::exit::main_with(daemon::cli::Cli::parse())
 }
