@@ -16,12 +16,16 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use hdrhistogram::Histogram;
 use ica_core::model::IcaModel;
-use protocol::{decode_frame_into, encode_frame_into, messages, FrameBuf};
+use protocol::{
+    decode_frame_into, decode_reply, encode_control_into, encode_frame_into, messages, Control,
+    FrameBuf, Reply,
+};
 use tokio::net::UdpSocket;
 use tokio_util::sync::CancellationToken;
 
 use crate::cli::BenchArgs;
 use crate::serve::config::RawConfig;
+use crate::serve::net::bind_receiver;
 use crate::serve::pipeline::{Pipeline, PipelineConfig};
 use crate::serve::stats::Stats;
 use crate::serve::synthetic::{frame_into, labels_datagram, random_model};
@@ -34,6 +38,22 @@ const MAX_RATE_HZ: f64 = 50_000.0;
 struct Seen {
     latency_us: Histogram<u64>,
     received: u64,
+}
+
+/// One run through the daemon: what the receivers saw, frames sent, the daemon's `/status`.
+struct Run {
+    seen: Seen,
+    sent: u64,
+    status: Vec<(String, i64)>,
+}
+
+impl Run {
+    fn get(&self, name: &str) -> i64 {
+        self.status
+            .iter()
+            .find(|(k, _)| k == name)
+            .map_or(-1, |(_, v)| *v)
+    }
 }
 
 pub(crate) fn run(args: &BenchArgs) -> Result<()> {
@@ -63,25 +83,25 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         args.clients,
         args.seconds
     );
-    for (name, s) in [("daemon", &daemon), ("relay", &relay)] {
-        crate::out!("  {name}: {} of ~{sent} datagrams received", s.0.received);
+    for (name, s) in [("daemon", &daemon.seen), ("relay", &relay)] {
+        crate::out!("  {name}: {} of ~{sent} datagrams received", s.received);
     }
+    crate::out!(
+        "  inside the daemon: received -> processed p50 {} µs, p99 {} µs; processed -> sent p50 {} µs, p99 {} µs",
+        daemon.get("processed_p50_us"),
+        daemon.get("processed_p99_us"),
+        daemon.get("sent_p50_us"),
+        daemon.get("sent_p99_us"),
+    );
     for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999), ("max", 1.0)] {
-        let d = daemon.0.latency_us.value_at_quantile(q);
-        let r = relay.0.latency_us.value_at_quantile(q);
+        let d = daemon.seen.latency_us.value_at_quantile(q);
+        let r = relay.latency_us.value_at_quantile(q);
         crate::out!(
             "{label} added latency: {d} µs (relay {r} µs, ratio {:.2}x)",
             d as f64 / r.max(1) as f64
         );
     }
-    let max_sent = MAX_RATE_HZ as u64;
-    crate::out!(
-        "max rate: {} frames sent at {MAX_RATE_HZ} /s, {} received, loss {:.3}%",
-        max.1,
-        max.0.received,
-        100.0 * (1.0 - max.0.received as f64 / max.1.max(1) as f64)
-    );
-    let _ = max_sent;
+    print_max_rate(&max)?;
     let (per_frame_us, fps) = processing_rate(&model)?;
     crate::out!(
         "processing: {per_frame_us:.2} µs/frame median over batches, {fps:.0} frames/s on one thread"
@@ -89,14 +109,52 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// Paced traffic through the daemon; returns what receivers saw and frames sent.
+/// Where the frames of the max-rate run went, stage by stage.
+fn print_max_rate(max: &Run) -> Result<()> {
+    let received = max.seen.received as i64;
+    let frames_in = max.get("frames_in");
+    crate::out!(
+        "max rate: {} frames sent at {MAX_RATE_HZ} /s, {received} received, loss {:.3}%",
+        max.sent,
+        100.0 * (1.0 - received as f64 / max.sent.max(1) as f64)
+    );
+    crate::out!(
+        "  lost at the daemon's socket {}, dropped in the daemon {} (queue full {}, stale {}), \
+         not sent {}, lost at the receiver's socket {}",
+        max.sent as i64 - frames_in,
+        frames_in - max.get("frames_out"),
+        max.get("frames_dropped"),
+        max.get("dropped_stale"),
+        max.get("dropped_send_buffer") + max.get("send_errors"),
+        max.get("datagrams_sent") - received,
+    );
+    Ok(())
+}
+
+/// Asks the daemon for its `/status` counters.
+async fn status(control: SocketAddr) -> Result<Vec<(String, i64)>> {
+    let sock = UdpSocket::bind("127.0.0.1:0").await?;
+    let mut out = Vec::new();
+    encode_control_into(&Control::Status, &mut out);
+    sock.send_to(&out, control).await?;
+    let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD];
+    let n = tokio::time::timeout(Duration::from_secs(2), sock.recv(&mut buf))
+        .await
+        .context("no /status reply from the daemon")??;
+    match decode_reply(&buf[..n])? {
+        Reply::Status(pairs) => Ok(pairs),
+        other => anyhow::bail!("unexpected reply to /status: {other:?}"),
+    }
+}
+
+/// Paced traffic through the daemon.
 async fn through_daemon(
     model: &IcaModel,
     performers: usize,
     clients: usize,
     rate_hz: f64,
     secs: Duration,
-) -> Result<(Seen, u64)> {
+) -> Result<Run> {
     let (receivers, addrs) = receivers(clients).await?;
     let mut raw = RawConfig {
         listen: Some("127.0.0.1:0".into()),
@@ -110,13 +168,19 @@ async fn through_daemon(
     let config = raw.validate()?;
     let bound = crate::serve::bind_with(config, model.clone()).await?;
     let to = bound.frame_addr()?;
+    let control = bound.control_addr()?;
     let shutdown = CancellationToken::new();
     let server = tokio::spawn(bound.run(shutdown.clone()));
     let sent = send_all(model, performers, to, rate_hz, secs).await?;
     tokio::time::sleep(Duration::from_millis(200)).await;
+    let status = status(control).await?;
     shutdown.cancel();
     server.await.context("daemon task")??;
-    Ok((collect(receivers).await, sent))
+    Ok(Run {
+        seen: collect(receivers).await,
+        sent,
+        status,
+    })
 }
 
 /// The same traffic through a minimal relay.
@@ -125,9 +189,9 @@ async fn through_relay(
     performers: usize,
     clients: usize,
     secs: Duration,
-) -> Result<(Seen, u64)> {
+) -> Result<Seen> {
     let (receivers, addrs) = receivers(clients).await?;
-    let relay = UdpSocket::bind("127.0.0.1:0").await?;
+    let relay = bind_receiver(([127, 0, 0, 1], 0).into())?;
     let to = relay.local_addr()?;
     let stop = CancellationToken::new();
     let stop2 = stop.clone();
@@ -143,11 +207,11 @@ async fn through_relay(
             }
         }
     });
-    let sent = send_all(model, performers, to, 120.0, secs).await?;
+    send_all(model, performers, to, 120.0, secs).await?;
     tokio::time::sleep(Duration::from_millis(200)).await;
     stop.cancel();
     task.await.context("relay task")?;
-    Ok((collect(receivers).await, sent))
+    Ok(collect(receivers).await)
 }
 
 type Receivers = Vec<(tokio::task::JoinHandle<Seen>, CancellationToken)>;
@@ -156,7 +220,8 @@ async fn receivers(k: usize) -> Result<(Receivers, Vec<SocketAddr>)> {
     let mut out = Vec::with_capacity(k);
     let mut addrs = Vec::with_capacity(k);
     for _ in 0..k {
-        let sock = UdpSocket::bind("127.0.0.1:0").await?;
+        // A client that expects bursts sizes its buffer like the daemon does.
+        let sock = bind_receiver(([127, 0, 0, 1], 0).into())?;
         addrs.push(sock.local_addr()?);
         let stop = CancellationToken::new();
         let stop2 = stop.clone();

@@ -104,6 +104,11 @@ impl Clients {
         self.list.iter()
     }
 
+    /// The `i`-th subscriber.
+    pub fn get(&self, i: usize) -> Option<&Subscriber> {
+        self.list.get(i)
+    }
+
     /// Subscribers now.
     pub fn len(&self) -> usize {
         self.list.len()

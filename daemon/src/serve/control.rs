@@ -1,5 +1,5 @@
-//! The control task: decodes control messages, routes them (edits, models and recordings to
-//! the processing thread, subscriptions to the sender) and answers each with
+//! The control task: decodes control messages, routes them (edits, subscriptions, models and
+//! recordings) to the processing thread, which applies them between frames, and answers each with
 //! `<address>/confirm` or `/emoshift/error`. Model loads run on a blocking thread; SIGHUP
 //! reloads the last model file.
 
@@ -14,11 +14,10 @@ use protocol::{
     decode_control, encode_confirm_into, encode_error_into, encode_status_into, Control,
 };
 use tokio::net::UdpSocket;
-use tokio::sync::{mpsc, oneshot};
+use tokio::sync::oneshot;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
-use super::sender::ClientCmd;
 use super::server::Answer;
 use super::stats::Stats;
 
@@ -30,6 +29,8 @@ const ANSWER_TIMEOUT: Duration = Duration::from_secs(2);
 pub(crate) enum Cmd {
     /// An edit setting.
     Edit(Control, Answer),
+    /// `/subscribe` or `/unsubscribe` from a peer.
+    Client(SocketAddr, Control, Answer),
     /// Swap in a validated model.
     SetModel(Arc<IcaModel>, Answer),
     /// Start recording to a path.
@@ -43,7 +44,6 @@ pub(crate) enum Cmd {
 pub(crate) struct ControlCtx {
     pub(crate) socket: Arc<UdpSocket>,
     pub(crate) cmd_tx: Sender<Cmd>,
-    pub(crate) client_tx: mpsc::Sender<ClientCmd>,
     pub(crate) stats: Arc<Mutex<Stats>>,
     pub(crate) model_path: Arc<Mutex<PathBuf>>,
     pub(crate) tracker: TaskTracker,
@@ -107,16 +107,7 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
     }
     let result = match &control {
         Control::Subscribe { .. } | Control::Unsubscribe { .. } => {
-            let (tx, rx) = oneshot::channel();
-            let cmd = ClientCmd {
-                peer,
-                control: control.clone(),
-                reply: tx,
-            };
-            match ctx.client_tx.send(cmd).await {
-                Ok(()) => wait(rx).await,
-                Err(_) => Err("shutting down".to_string()),
-            }
+            ask(ctx, |tx| Cmd::Client(peer, control.clone(), tx)).await
         }
         Control::RecordStart(path) => {
             ask(ctx, |tx| Cmd::RecordStart(PathBuf::from(path), tx)).await

@@ -8,7 +8,9 @@
 //! - [`streams`]: one stream per source address and layout id, performers;
 //! - [`clients`]: subscribers, sans-IO; [`stats`]: counters and histograms;
 //! - [`record`]: recordings; [`synthetic`]: models and frames for bench and tests;
-//! - `server`, `control`, `sender`: the tasks, the only code that awaits.
+//! - [`net`]: sockets (large receive buffers, connected senders);
+//! - `server`, `control`: the tasks, the only code that awaits; `sender`: the fan-out to the
+//!   subscribers, run on the processing thread.
 //!
 //! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
 //! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).
@@ -17,6 +19,7 @@ pub mod clients;
 pub mod config;
 mod control;
 pub mod edit_state;
+pub mod net;
 pub mod pipeline;
 pub mod record;
 mod sender;

@@ -1,111 +1,49 @@
-//! The sender task: the same encoded bytes to every subscriber, one connected socket per
-//! subscriber (so an ICMP port unreachable comes back as a send error and a vanished client
-//! is dropped), buffers returned to the processing thread's pool.
+//! Sending, on the processing thread: each frame's encoded bytes go straight from the
+//! pipeline's buffers to every subscriber. A relay's path is receive → send; handing the bytes
+//! to another thread here would add a wake-up (tens of µs on a loaded machine) to every frame,
+//! so the daemon's path stays receive → process → send.
+//!
+//! One connected, non-blocking std socket per subscriber: an ICMP port unreachable comes back
+//! as a send error on it, so a vanished client is dropped ([`Clients::handle_send`]). A full
+//! socket send buffer drops that datagram (counted) instead of stalling the thread that
+//! processes every stream.
 
 use std::collections::HashMap;
-use std::net::{Ipv4Addr, Ipv6Addr, SocketAddr};
-use std::sync::atomic::{AtomicU8, Ordering};
-use std::sync::{Arc, Mutex};
+use std::io::ErrorKind;
+use std::net::{SocketAddr, UdpSocket};
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use crossbeam_channel::Sender as PoolTx;
+use hdrhistogram::Histogram;
 use protocol::{Control, Profile};
-use tokio::net::UdpSocket;
-use tokio::sync::mpsc;
 
 use super::clients::{ClientChange, Clients};
-use super::pipeline::Emitted;
-use super::server::Answer;
-use super::stats::Stats;
+use super::net::connect;
+use super::pipeline::{Emitted, ProfileMask};
+use super::stats::{SendCounters, Stats};
 use super::Config;
 
-/// A processed frame on its way to the subscribers, in a pooled buffer.
+/// How often dynamic subscriptions are checked for expiry.
+const EXPIRY_EVERY: Duration = Duration::from_secs(1);
+
+/// The subscribers and their sockets, owned by the processing thread.
 #[derive(Debug)]
-pub(crate) struct OutFrame {
-    received: Instant,
-    processed: Instant,
-    compact: Vec<u8>,
-    parts: Vec<u8>,
-    part_ends: Vec<usize>,
-    components: Vec<u8>,
-}
-
-impl Default for OutFrame {
-    fn default() -> Self {
-        let now = Instant::now();
-        OutFrame {
-            received: now,
-            processed: now,
-            compact: Vec::with_capacity(protocol::ETHERNET_PAYLOAD),
-            parts: Vec::new(),
-            part_ends: Vec::new(),
-            components: Vec::new(),
-        }
-    }
-}
-
-impl OutFrame {
-    /// Copies an emitted frame (capacity reused: no allocation once warm).
-    pub(crate) fn fill_from(&mut self, e: &Emitted<'_>, received: Instant) {
-        self.received = received;
-        self.processed = Instant::now();
-        for (dst, src) in [
-            (&mut self.compact, e.compact),
-            (&mut self.parts, e.parts),
-            (&mut self.components, e.components),
-        ] {
-            dst.clear();
-            dst.extend_from_slice(src);
-        }
-        self.part_ends.clear();
-        self.part_ends.extend_from_slice(e.part_ends);
-    }
-
-    /// Received → processed, microseconds.
-    pub(crate) fn processed_us(&self) -> u64 {
-        self.processed.duration_since(self.received).as_micros() as u64
-    }
-}
-
-/// A `/subscribe` or `/unsubscribe` from the control task.
-#[derive(Debug)]
-pub(crate) struct ClientCmd {
-    pub(crate) peer: SocketAddr,
-    pub(crate) control: Control,
-    pub(crate) reply: Answer,
-}
-
-/// The sender task's state.
-#[derive(Debug)]
-pub(crate) struct Sender {
+pub(crate) struct Fanout {
     clients: Clients,
     sockets: HashMap<SocketAddr, UdpSocket>,
-    stats: Arc<Mutex<Stats>>,
-    wanted: Arc<AtomicU8>,
+    /// Counters since the start.
+    pub(crate) counters: SendCounters,
+    /// Processed → sent to the last subscriber, µs, since the last merge.
+    pub(crate) sent_us: Histogram<u64>,
+    next_expiry: Instant,
 }
 
-/// A socket connected to `addr`, bound on loopback for a loopback peer.
-fn connect(addr: SocketAddr) -> std::io::Result<UdpSocket> {
-    let local: SocketAddr = match (addr.is_ipv4(), addr.ip().is_loopback()) {
-        (true, true) => (Ipv4Addr::LOCALHOST, 0).into(),
-        (true, false) => (Ipv4Addr::UNSPECIFIED, 0).into(),
-        (false, true) => (Ipv6Addr::LOCALHOST, 0).into(),
-        (false, false) => (Ipv6Addr::UNSPECIFIED, 0).into(),
-    };
-    let s = std::net::UdpSocket::bind(local)?;
-    s.connect(addr)?;
-    s.set_nonblocking(true)?;
-    UdpSocket::from_std(s)
-}
-
-impl Sender {
+impl Fanout {
     /// Opens the static subscribers' sockets.
-    pub(crate) fn new(
-        config: &Config,
-        stats: Arc<Mutex<Stats>>,
-        wanted: Arc<AtomicU8>,
-    ) -> Result<Sender> {
+    ///
+    /// # Errors
+    /// A static subscriber's socket cannot be opened.
+    pub(crate) fn new(config: &Config) -> Result<Fanout> {
         let clients = Clients::new(
             &config.send,
             config.max_subscribers,
@@ -117,58 +55,32 @@ impl Sender {
                 .map_err(|e| anyhow::anyhow!("opening a socket to subscriber {addr}: {e}"))?;
             sockets.insert(addr, s);
         }
-        let sender = Sender {
+        Ok(Fanout {
             clients,
             sockets,
-            stats,
-            wanted,
-        };
-        sender.publish();
-        Ok(sender)
+            counters: SendCounters::default(),
+            sent_us: Stats::histogram(),
+            next_expiry: Instant::now() + EXPIRY_EVERY,
+        })
     }
 
-    fn publish(&self) {
-        self.wanted.store(self.clients.wanted(), Ordering::Relaxed);
-        if let Ok(mut s) = self.stats.lock() {
-            s.clients = self.clients.len() as u64;
-        }
+    /// The profiles the subscribers want.
+    pub(crate) fn wanted(&self) -> ProfileMask {
+        self.clients.wanted()
     }
 
-    /// Runs until the processing thread closes `frames`.
-    pub(crate) async fn run(
-        mut self,
-        mut frames: mpsc::Receiver<OutFrame>,
-        pool: PoolTx<OutFrame>,
-        mut commands: mpsc::Receiver<ClientCmd>,
-    ) {
-        let mut expiry = tokio::time::interval(Duration::from_secs(1));
-        loop {
-            tokio::select! {
-                Some(cmd) = commands.recv() => self.command(cmd),
-                f = frames.recv() => match f {
-                    Some(f) => {
-                        self.send_all(&f).await;
-                        let _ = pool.try_send(f);
-                    }
-                    None => break,
-                },
-                _ = expiry.tick() => {
-                    for addr in self.clients.poll_expired(Instant::now()) {
-                        self.sockets.remove(&addr);
-                        tracing::info!(%addr, "subscription expired");
-                    }
-                    self.publish();
-                }
-            }
-        }
+    /// Subscribers now.
+    pub(crate) fn len(&self) -> usize {
+        self.clients.len()
     }
 
-    fn command(&mut self, cmd: ClientCmd) {
-        let r = self
-            .clients
-            .handle_control(Instant::now(), cmd.peer, &cmd.control)
-            .map_err(|e| e.to_string());
-        let r = match r {
+    /// Handles `/subscribe` or `/unsubscribe` from `peer`.
+    ///
+    /// # Errors
+    /// The refusal, as the text of the error reply.
+    pub(crate) fn command(&mut self, peer: SocketAddr, control: &Control) -> Result<(), String> {
+        let now = Instant::now();
+        match self.clients.handle_control(now, peer, control) {
             Ok(ClientChange::Added(addr)) => match connect(addr) {
                 Ok(s) => {
                     self.sockets.insert(addr, s);
@@ -176,13 +88,8 @@ impl Sender {
                     Ok(())
                 }
                 Err(e) => {
-                    self.clients
-                        .handle_control(
-                            Instant::now(),
-                            cmd.peer,
-                            &Control::Unsubscribe { port: addr.port() },
-                        )
-                        .ok();
+                    let undo = Control::Unsubscribe { port: addr.port() };
+                    let _ = self.clients.handle_control(now, peer, &undo);
                     Err(format!("cannot open a socket to {addr}: {e}"))
                 }
             },
@@ -191,68 +98,70 @@ impl Sender {
                 Ok(())
             }
             Ok(ClientChange::Renewed(_)) => Ok(()),
-            Err(e) => Err(e),
-        };
-        self.publish();
-        let _ = cmd.reply.send(r);
+            Err(e) => Err(e.to_string()),
+        }
     }
 
-    async fn send_all(&mut self, f: &OutFrame) {
-        let (mut sent, mut errors, mut dropped) = (0u64, 0u64, 0u64);
+    /// Drops the dynamic subscriptions whose lease ended (checked once a second); `true` when
+    /// the set changed.
+    pub(crate) fn expire(&mut self, now: Instant) -> bool {
+        if now < self.next_expiry {
+            return false;
+        }
+        self.next_expiry = now + EXPIRY_EVERY;
+        let gone = self.clients.poll_expired(now);
+        for addr in &gone {
+            self.sockets.remove(addr);
+            tracing::info!(%addr, "subscription expired");
+        }
+        !gone.is_empty()
+    }
+
+    /// Sends one processed frame to every subscriber in its profile; `true` when a subscriber
+    /// was dropped (the wanted profiles may have changed).
+    pub(crate) fn send(&mut self, e: &Emitted<'_>, processed: Instant) -> bool {
+        let mut dropped_any = false;
         let mut i = 0;
-        loop {
-            let next = self.clients.iter().nth(i).map(|s| (s.addr, s.profile));
-            let Some((addr, profile)) = next else { break };
+        while let Some(s) = self.clients.get(i) {
+            let (addr, profile) = (s.addr, s.profile);
             let ok = match self.sockets.get(&addr) {
-                Some(sock) => send_profile(sock, profile, f, &mut sent).await,
+                Some(sock) => send_profile(sock, profile, e, &mut self.counters),
                 None => false,
             };
-            errors += u64::from(!ok);
+            self.counters.send_errors += u64::from(!ok);
             if self.clients.handle_send(addr, ok) {
                 self.sockets.remove(&addr);
-                dropped += 1;
+                self.counters.clients_dropped += 1;
+                dropped_any = true;
                 tracing::warn!(%addr, "subscriber dropped after repeated send failures");
             } else {
                 i += 1;
             }
         }
-        let sent_us = f.processed.elapsed().as_micros() as u64;
-        if let Ok(mut s) = self.stats.lock() {
-            s.send.datagrams_sent += sent;
-            s.send.send_errors += errors;
-            s.send.clients_dropped += dropped;
-            if !self.clients.is_empty() {
-                Stats::record(&mut s.sent_us, sent_us);
-            }
+        if !self.clients.is_empty() {
+            Stats::record(&mut self.sent_us, processed.elapsed().as_micros() as u64);
         }
-        if dropped > 0 {
-            self.publish();
-        }
+        dropped_any
     }
 }
 
-/// Sends one frame in `profile`; `false` on any send error.
-async fn send_profile(sock: &UdpSocket, profile: Profile, f: &OutFrame, sent: &mut u64) -> bool {
+/// Sends one frame in `profile`; `false` on a send error (a full send buffer is counted as a
+/// dropped datagram, not as the subscriber's failure).
+fn send_profile(sock: &UdpSocket, profile: Profile, e: &Emitted<'_>, c: &mut SendCounters) -> bool {
     let mut ok = true;
+    let mut one = |bytes: &[u8]| match sock.send(bytes) {
+        Ok(_) => c.datagrams_sent += 1,
+        Err(err) if err.kind() == ErrorKind::WouldBlock => c.dropped_send_buffer += 1,
+        Err(_) => ok = false,
+    };
     match profile {
-        Profile::Compact | Profile::Components => {
-            let bytes = if profile == Profile::Compact {
-                &f.compact
-            } else {
-                &f.components
-            };
-            if bytes.is_empty() {
-                return true;
-            }
-            ok = sock.send(bytes).await.is_ok();
-            *sent += u64::from(ok);
-        }
+        Profile::Compact if !e.compact.is_empty() => one(e.compact),
+        Profile::Components if !e.components.is_empty() => one(e.components),
+        Profile::Compact | Profile::Components => {}
         Profile::FlatSplit => {
             let mut start = 0;
-            for &end in &f.part_ends {
-                let r = sock.send(&f.parts[start..end]).await.is_ok();
-                *sent += u64::from(r);
-                ok &= r;
+            for &end in e.part_ends {
+                one(&e.parts[start..end]);
                 start = end;
             }
         }

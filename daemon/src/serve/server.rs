@@ -2,18 +2,17 @@
 //!
 //! - **receive**: frame socket → pooled buffer → bounded crossbeam channel; when full the
 //!   oldest frame is dropped and counted (latest frame wins);
-//! - **processing** (one blocking thread): [`Pipeline`] per frame, control commands between
-//!   frames, recording; the encoded bytes go to the sender in pooled buffers;
-//! - **sender**: the same bytes to every subscriber, each on its own connected socket so an
-//!   ICMP port unreachable surfaces as a send error;
+//! - **processing** (one blocking thread): [`Pipeline`] per frame, then the encoded bytes
+//!   straight to every subscriber ([`Fanout`]), control commands (edits, subscriptions,
+//!   models, recordings) between frames, recording;
 //! - **control**: decodes control messages and answers them;
 //! - **stats**: logs the counters every few seconds; **SIGHUP** reloads the model.
 //!
-//! Shutdown: the token stops receive and control; the processing thread drains the queue and
-//! closes the recording; the sender drains what is left and ends.
+//! Shutdown: the token stops receive and control; the processing thread drains the queue,
+//! sends what it processes and closes the recording.
 
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -21,21 +20,21 @@ use anyhow::{Context, Result};
 use crossbeam_channel::{Receiver, Sender};
 use ica_core::model::IcaModel;
 use tokio::net::UdpSocket;
-use tokio::sync::{mpsc, oneshot};
+use tokio::sync::oneshot;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
 use super::control::{self, Cmd, ControlCtx};
 use super::pipeline::{Emitted, Pipeline, PipelineConfig};
 use super::record::Recording;
-use super::sender::{self, OutFrame};
+use super::sender::Fanout;
 use super::stats::Stats;
 use super::streams::Performer;
 use super::Config;
 
 /// Frames processed between two merges of the counters into the shared [`Stats`].
 const STATS_EVERY_FRAMES: u64 = 64;
-/// Pooled buffers kept for received datagrams and encoded frames.
+/// Pooled buffers kept for received datagrams.
 const POOL: usize = 256;
 
 /// One received datagram.
@@ -97,8 +96,7 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
             amount: p.amount,
         });
     }
-    let frames = UdpSocket::bind(config.listen)
-        .await
+    let frames = super::net::bind_receiver(config.listen)
         .with_context(|| format!("binding the frame socket {}", config.listen))?;
     let control = UdpSocket::bind(config.control)
         .await
@@ -137,13 +135,9 @@ impl Bound {
         let tracker = TaskTracker::new();
         let stats = Arc::new(Mutex::new(Stats::new()));
         let queue_dropped = Arc::new(AtomicU64::new(0));
-        let wanted = Arc::new(AtomicU8::new(0));
         let (frame_tx, frame_rx) = crossbeam_channel::bounded::<InFrame>(self.config.queue);
         let (free_tx, free_rx) = crossbeam_channel::bounded::<Vec<u8>>(POOL);
         let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Cmd>(64);
-        let (out_tx, out_rx) = mpsc::channel::<OutFrame>(POOL);
-        let (out_free_tx, out_free_rx) = crossbeam_channel::bounded::<OutFrame>(POOL);
-        let (client_tx, client_rx) = mpsc::channel(64);
 
         let mut pipeline = Pipeline::new(
             self.model,
@@ -153,17 +147,16 @@ impl Bound {
                 ..PipelineConfig::default()
             },
         );
-        pipeline.set_wanted(0);
+        let fanout = Fanout::new(&self.config)?;
+        pipeline.set_wanted(fanout.wanted());
         let processing = Processing {
             pipeline,
+            fanout,
             frame_rx: frame_rx.clone(),
             free_tx,
             cmd_rx,
-            out_tx,
-            out_free_rx,
             stats: Arc::clone(&stats),
             queue_dropped: Arc::clone(&queue_dropped),
-            wanted: Arc::clone(&wanted),
             recording: None,
             processed_us: Stats::histogram(),
         };
@@ -178,12 +171,9 @@ impl Bound {
             shutdown.clone(),
         );
         tracker.spawn(receive);
-        let sender = sender::Sender::new(&self.config, Arc::clone(&stats), Arc::clone(&wanted))?;
-        tracker.spawn(sender.run(out_rx, out_free_tx, client_rx));
         let ctx = ControlCtx {
             socket: Arc::new(self.control),
             cmd_tx,
-            client_tx,
             stats: Arc::clone(&stats),
             model_path: Arc::new(Mutex::new(self.config.model.clone())),
             tracker: tracker.clone(),
@@ -250,14 +240,12 @@ async fn receive(
 /// The processing thread's state.
 struct Processing {
     pipeline: Pipeline,
+    fanout: Fanout,
     frame_rx: Receiver<InFrame>,
     free_tx: Sender<Vec<u8>>,
     cmd_rx: Receiver<Cmd>,
-    out_tx: mpsc::Sender<OutFrame>,
-    out_free_rx: Receiver<OutFrame>,
     stats: Arc<Mutex<Stats>>,
     queue_dropped: Arc<AtomicU64>,
-    wanted: Arc<AtomicU8>,
     recording: Option<Recording>,
     processed_us: hdrhistogram::Histogram<u64>,
 }
@@ -271,13 +259,21 @@ impl Processing {
                     Ok(frame) => self.process(frame),
                     Err(_) => break,
                 },
-                recv(self.cmd_rx) -> cmd => if let Ok(cmd) = cmd { self.command(cmd) },
-                default(Duration::from_millis(50)) => self.merge_stats(),
+                recv(self.cmd_rx) -> cmd => if let Ok(cmd) = cmd {
+                    self.command(cmd);
+                    // So that a `/status` right after a command sees its effect.
+                    self.merge_stats();
+                },
+                default(Duration::from_millis(50)) => {
+                    self.merge_stats();
+                    self.housekeeping();
+                }
             }
             since_merge += 1;
             if since_merge >= STATS_EVERY_FRAMES {
                 since_merge = 0;
                 self.merge_stats();
+                self.housekeeping();
             }
         }
         self.merge_stats();
@@ -288,32 +284,38 @@ impl Processing {
     }
 
     fn process(&mut self, frame: InFrame) {
-        self.pipeline
-            .set_wanted(self.wanted.load(Ordering::Relaxed));
-        let out_tx = &self.out_tx;
-        let pool = &self.out_free_rx;
-        let recording = &mut self.recording;
+        let Processing {
+            pipeline,
+            fanout,
+            recording,
+            processed_us,
+            ..
+        } = self;
         let received = frame.received;
-        let processed = &mut self.processed_us;
-        let mut send_dropped = 0;
-        self.pipeline
-            .handle_datagram(frame.peer, &frame.bytes, &mut |e: &Emitted<'_>| {
-                if let Some(rec) = recording.as_mut() {
-                    rec.push(e.labels, e.rate_hz, e.frame_number, e.xyz);
-                }
-                let mut out = pool.try_recv().unwrap_or_default();
-                out.fill_from(e, received);
-                Stats::record(processed, out.processed_us());
-                if out_tx.try_send(out).is_err() {
-                    send_dropped += 1;
-                }
-            });
-        if send_dropped > 0 {
-            if let Ok(mut s) = self.stats.lock() {
-                s.send.dropped_send_queue += send_dropped;
+        let mut clients_changed = false;
+        pipeline.handle_datagram(frame.peer, &frame.bytes, &mut |e: &Emitted<'_>| {
+            let processed = Instant::now();
+            Stats::record(
+                processed_us,
+                processed.duration_since(received).as_micros() as u64,
+            );
+            // Send before recording: the file write is not on the subscribers' path.
+            clients_changed |= fanout.send(e, processed);
+            if let Some(rec) = recording.as_mut() {
+                rec.push(e.labels, e.rate_hz, e.frame_number, e.xyz);
             }
+        });
+        if clients_changed {
+            self.pipeline.set_wanted(self.fanout.wanted());
         }
         let _ = self.free_tx.try_send(frame.bytes);
+    }
+
+    /// Between frames: subscriptions whose lease ended.
+    fn housekeeping(&mut self) {
+        if self.fanout.expire(Instant::now()) {
+            self.pipeline.set_wanted(self.fanout.wanted());
+        }
     }
 
     fn merge_stats(&mut self) {
@@ -321,9 +323,13 @@ impl Processing {
         s.counters = self.pipeline.counters.clone();
         s.counters.dropped_queue_full = self.queue_dropped.load(Ordering::Relaxed);
         s.streams = self.pipeline.stream_count() as u64;
+        s.send = self.fanout.counters.clone();
+        s.clients = self.fanout.len() as u64;
         // Same bounds on both sides, so adding never fails.
         let _ = s.processed_us.add(&self.processed_us);
         self.processed_us.reset();
+        let _ = s.sent_us.add(&self.fanout.sent_us);
+        self.fanout.sent_us.reset();
     }
 
     fn command(&mut self, cmd: Cmd) {
@@ -333,6 +339,11 @@ impl Processing {
                     .pipeline
                     .handle_edit(&control)
                     .map_err(|e| e.to_string());
+                let _ = reply.send(r);
+            }
+            Cmd::Client(peer, control, reply) => {
+                let r = self.fanout.command(peer, &control);
+                self.pipeline.set_wanted(self.fanout.wanted());
                 let _ = reply.send(r);
             }
             Cmd::SetModel(model, reply) => {

@@ -49,7 +49,7 @@ impl Counters {
     }
 }
 
-/// Counters of the sender task.
+/// Counters of sending.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct SendCounters {
     /// Datagrams sent.
@@ -58,11 +58,11 @@ pub struct SendCounters {
     pub send_errors: u64,
     /// Subscribers dropped after repeated failures.
     pub clients_dropped: u64,
-    /// Frames dropped between processing and sending (sender behind).
-    pub dropped_send_queue: u64,
+    /// Datagrams not sent because the socket's send buffer was full.
+    pub dropped_send_buffer: u64,
 }
 
-/// Everything `/status` reports, merged from the processing thread and the sender task.
+/// Everything `/status` reports, merged from the processing thread.
 #[derive(Debug)]
 pub struct Stats {
     /// Processing counters (latest snapshot).
@@ -130,7 +130,7 @@ impl Stats {
             ("datagrams_sent", self.send.datagrams_sent),
             ("send_errors", self.send.send_errors),
             ("clients_dropped", self.send.clients_dropped),
-            ("dropped_send_queue", self.send.dropped_send_queue),
+            ("dropped_send_buffer", self.send.dropped_send_buffer),
             ("clients", self.clients),
             ("streams", self.streams),
         ]
