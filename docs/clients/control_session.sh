@@ -19,7 +19,7 @@ oscsend "$D" "$P" /emotion/alpha if 2 0.5       # raw translate of component 2
 oscsend "$D" "$P" /component/gain if 1 1.2      # exaggerate component 1
 oscsend "$D" "$P" /bypass i 1                   # pass frames through unedited
 oscsend "$D" "$P" /bypass i 0
-oscsend "$D" "$P" /record/start s /tmp/edited.c3d
+oscsend "$D" "$P" /record/start ss /tmp/edited.c3d /tmp/input.c3d   # edited + raw input
 sleep 2
 oscsend "$D" "$P" /record/stop
 oscsend "$D" "$P" /model/load s model.json      # hot reload; a bad file keeps the old model

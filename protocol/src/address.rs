@@ -37,7 +37,7 @@ pub const SUBSCRIBE: &str = "/subscribe";
 pub const UNSUBSCRIBE: &str = "/unsubscribe";
 /// Control: load a model file, `,s`.
 pub const MODEL_LOAD: &str = "/model/load";
-/// Control: start recording to a path, `,s`.
+/// Control: start recording to a path, `,s`; `,ss` records the raw input to the second.
 pub const RECORD_START: &str = "/record/start";
 /// Control: stop recording, no arguments.
 pub const RECORD_STOP: &str = "/record/stop";

@@ -75,8 +75,14 @@ pub enum Control {
     },
     /// `/model/load ,s`: path of a model file.
     ModelLoad(String),
-    /// `/record/start ,s`: path to record to.
-    RecordStart(String),
+    /// `/record/start ,s` or `,ss`: path to record the edited stream to, and optionally a
+    /// second path for the raw input beside it.
+    RecordStart {
+        /// The edited stream's file.
+        path: String,
+        /// The raw input's file, if wanted.
+        raw: Option<String>,
+    },
     /// `/record/stop`.
     RecordStop,
     /// `/status`: answered with `/status/confirm` and the counters.
@@ -260,7 +266,14 @@ pub(crate) fn parse_control(address: &str, args: Vec<OscType>) -> Result<Control
             port: port(addr, *p)?,
         },
         (a::MODEL_LOAD, [OscType::String(s)]) => Control::ModelLoad(s.clone()),
-        (a::RECORD_START, [OscType::String(s)]) => Control::RecordStart(s.clone()),
+        (a::RECORD_START, [OscType::String(s)]) => Control::RecordStart {
+            path: s.clone(),
+            raw: None,
+        },
+        (a::RECORD_START, [OscType::String(s), OscType::String(raw)]) => Control::RecordStart {
+            path: s.clone(),
+            raw: Some(raw.clone()),
+        },
         (a::RECORD_STOP, []) => Control::RecordStop,
         (a::STATUS, []) => Control::Status,
         _ => return Err(wrong()),
@@ -279,7 +292,7 @@ const CONTROL_SHAPES: [(&str, &str); 12] = [
     (a::SUBSCRIBE, ",is"),
     (a::UNSUBSCRIBE, ",i"),
     (a::MODEL_LOAD, ",s"),
-    (a::RECORD_START, ",s"),
+    (a::RECORD_START, ",s or ,ss"),
     (a::RECORD_STOP, ","),
     (a::STATUS, ","),
 ];
@@ -297,7 +310,7 @@ impl Control {
             Control::Subscribe { .. } => a::SUBSCRIBE,
             Control::Unsubscribe { .. } => a::UNSUBSCRIBE,
             Control::ModelLoad(_) => a::MODEL_LOAD,
-            Control::RecordStart(_) => a::RECORD_START,
+            Control::RecordStart { .. } => a::RECORD_START,
             Control::RecordStop => a::RECORD_STOP,
             Control::Status => a::STATUS,
         }
@@ -307,9 +320,11 @@ impl Control {
     pub fn args(&self) -> Vec<OscType> {
         use OscType as T;
         match self {
-            Control::Target(s) | Control::ModelLoad(s) | Control::RecordStart(s) => {
-                vec![T::String(s.clone())]
-            }
+            Control::Target(s) | Control::ModelLoad(s) => vec![T::String(s.clone())],
+            Control::RecordStart { path, raw } => std::iter::once(path)
+                .chain(raw)
+                .map(|s| T::String(s.clone()))
+                .collect(),
             Control::Amount(v) | Control::Ramp(v) => vec![T::Float(*v)],
             Control::Alpha {
                 component,

@@ -27,7 +27,7 @@
 //! | `/subscribe` | `,is` | control | port on the sender's host, profile (`compact`, `flat-split`, `components`) |
 //! | `/unsubscribe` | `,i` | control | port on the sender's host |
 //! | `/model/load` | `,s` | control | model path |
-//! | `/record/start` | `,s` | control | recording path |
+//! | `/record/start` | `,s` / `,ss` | control | recording path (and the raw input's) |
 //! | `/record/stop` | `,` | control | |
 //! | `/status` | `,` | control | asks for the counters |
 //! | `<control>/confirm` | as the control | reply | accepted; echoes the arguments in canonical types |

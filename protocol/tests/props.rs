@@ -275,7 +275,7 @@ fn control_strategy() -> impl Strategy<Value = Control> {
             .prop_map(|(port, profile)| Control::Subscribe { port, profile }),
         (1..=u16::MAX).prop_map(|port| Control::Unsubscribe { port }),
         text.prop_map(Control::ModelLoad),
-        text.prop_map(Control::RecordStart),
+        (text, prop::option::of(text)).prop_map(|(path, raw)| Control::RecordStart { path, raw }),
         Just(Control::RecordStop),
         Just(Control::Status),
     ]

@@ -33,8 +33,8 @@ pub(crate) enum Cmd {
     Client(SocketAddr, Control, Answer),
     /// Swap in a validated model.
     SetModel(Arc<IcaModel>, Answer),
-    /// Start recording to a path.
-    RecordStart(PathBuf, Answer),
+    /// Start recording to a path, and the raw input to another.
+    RecordStart(PathBuf, Option<PathBuf>, Answer),
     /// Stop recording.
     RecordStop(Answer),
 }
@@ -109,8 +109,9 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
         Control::Subscribe { .. } | Control::Unsubscribe { .. } => {
             ask(ctx, |tx| Cmd::Client(peer, control.clone(), tx)).await
         }
-        Control::RecordStart(path) => {
-            ask(ctx, |tx| Cmd::RecordStart(PathBuf::from(path), tx)).await
+        Control::RecordStart { path, raw } => {
+            let raw = raw.as_ref().map(PathBuf::from);
+            ask(ctx, |tx| Cmd::RecordStart(PathBuf::from(path), raw, tx)).await
         }
         Control::RecordStop => ask(ctx, Cmd::RecordStop).await,
         other => ask(ctx, |tx| Cmd::Edit(other.clone(), tx)).await,

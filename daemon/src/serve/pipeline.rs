@@ -53,10 +53,10 @@ pub struct Emitted<'a> {
     pub components: &'a [u8],
     /// Edited positions in model order (gaps filled by the model).
     pub xyz: &'a [f32],
-    /// Input positions in model order, and which were missing.
-    pub raw_xyz: &'a [f32],
-    /// Missing flags of the input, model order.
-    pub raw_missing: &'a [bool],
+    /// The frame as received: every marker the source sent, with its gaps.
+    pub input: &'a FrameBuf,
+    /// The source's labels of `input`.
+    pub input_labels: &'a [String],
     /// The stream's model labels.
     pub labels: &'a [String],
     /// The stream's model rate.
@@ -317,8 +317,11 @@ impl Pipeline {
             part_ends: &self.part_ends,
             components: &self.components,
             xyz: out,
-            raw_xyz: xyz,
-            raw_missing: missing,
+            input: &self.frame_in,
+            input_labels: self
+                .layouts
+                .layout_for(&peer, header.marker_count)
+                .map_or(&[], |l| &l.names),
             labels: model.labels(),
             rate_hz: rate,
         });

@@ -302,7 +302,7 @@ impl Processing {
             // Send before recording: the file write is not on the subscribers' path.
             clients_changed |= fanout.send(e, processed);
             if let Some(rec) = recording.as_mut() {
-                rec.push(e.labels, e.rate_hz, e.frame_number, e.xyz);
+                rec.push(e);
             }
         });
         if clients_changed {
@@ -350,11 +350,12 @@ impl Processing {
                 self.pipeline.set_model(model);
                 let _ = reply.send(Ok(()));
             }
-            Cmd::RecordStart(path, reply) => {
+            Cmd::RecordStart(path, raw, reply) => {
                 if let Some(rec) = self.recording.take() {
                     finish_recording(rec);
                 }
-                let r = Recording::start(&path).map(|rec| self.recording = Some(rec));
+                let r =
+                    Recording::start(&path, raw.as_deref()).map(|rec| self.recording = Some(rec));
                 let _ = reply.send(r.map_err(|e| e.to_string()));
             }
             Cmd::RecordStop(reply) => {
@@ -369,9 +370,8 @@ impl Processing {
 }
 
 fn finish_recording(rec: Recording) {
-    match rec.finish() {
-        Ok(frames) => tracing::info!(frames, "recording closed"),
-        Err(e) => tracing::warn!(error = %e, "recording failed"),
+    if let Err(e) = rec.finish() {
+        tracing::warn!(error = %e, "recording failed");
     }
 }
 
