@@ -32,8 +32,12 @@ use super::stats::Stats;
 use super::streams::Performer;
 use super::Config;
 
-/// Frames processed between two merges of the counters into the shared [`Stats`].
-const STATS_EVERY_FRAMES: u64 = 64;
+/// The processing thread merges its counters and histograms into the shared [`Stats`] (a
+/// lock, a histogram add and reset: tens of µs) only between bursts: when its queue is empty
+/// and this long has passed since the last merge, after 50 ms idle, or after a command.
+const MERGE_EVERY: Duration = Duration::from_millis(100);
+/// ... and at least this often under sustained load, when the queue is never empty.
+const MERGE_AT_LEAST: Duration = Duration::from_secs(1);
 /// Pooled buffers kept for received datagrams.
 const POOL: usize = 256;
 
@@ -252,11 +256,21 @@ struct Processing {
 
 impl Processing {
     fn run(mut self) -> Result<()> {
-        let mut since_merge = 0u64;
+        let mut last_merge = Instant::now();
         loop {
             crossbeam_channel::select! {
                 recv(self.frame_rx) -> msg => match msg {
-                    Ok(frame) => self.process(frame),
+                    Ok(frame) => {
+                        self.process(frame);
+                        let since = last_merge.elapsed();
+                        if since >= MERGE_AT_LEAST
+                            || (since >= MERGE_EVERY && self.frame_rx.is_empty())
+                        {
+                            self.merge_stats();
+                            self.housekeeping();
+                            last_merge = Instant::now();
+                        }
+                    }
                     Err(_) => break,
                 },
                 recv(self.cmd_rx) -> cmd => if let Ok(cmd) = cmd {
@@ -267,13 +281,8 @@ impl Processing {
                 default(Duration::from_millis(50)) => {
                     self.merge_stats();
                     self.housekeeping();
+                    last_merge = Instant::now();
                 }
-            }
-            since_merge += 1;
-            if since_merge >= STATS_EVERY_FRAMES {
-                since_merge = 0;
-                self.merge_stats();
-                self.housekeeping();
             }
         }
         self.merge_stats();
