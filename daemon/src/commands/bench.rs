@@ -1,9 +1,11 @@
 //! `emoshift bench`: the daemon against a plain UDP relay on loopback, in one run.
 //!
-//! 1. Paced: N senders at 120 Hz, K receivers, through the daemon and then through a minimal
-//!    relay (receive, send the same bytes to every receiver). Each frame carries its send time
-//!    in the capture-time field, which the daemon keeps, so a receiver measures the whole path.
-//! 2. Max rate: one sender at 50,000 frames/s through the daemon to one receiver: loss.
+//! 1. Paced: N senders at 120 Hz, K receivers, through the daemon and through a minimal relay
+//!    (receive, send the same bytes to every receiver), alternating in rounds of a second.
+//!    Each frame carries its send time in the capture-time field, which the daemon keeps, so a
+//!    receiver measures the whole path. The daemon's `/status` tells its own stage latencies.
+//! 2. Max rate: one sender at 50,000 frames/s through the daemon to one receiver: loss, and
+//!    where frames went (from `/status`).
 //! 3. One processing thread: frames through [`Pipeline`] back to back (109 markers, m = 20).
 //!
 //! Bounded in time, only 127.0.0.1.
@@ -33,6 +35,9 @@ use crate::serve::synthetic::{frame_into, labels_datagram, random_model};
 const MARKERS: usize = 109;
 const COMPONENTS: usize = 20;
 const MAX_RATE_HZ: f64 = 50_000.0;
+/// The daemon and the relay alternate in rounds of at most this long, so that a change in
+/// the machine's load during the run falls on both alike.
+const ROUND: Duration = Duration::from_secs(1);
 
 /// What the receivers saw.
 struct Seen {
@@ -47,7 +52,29 @@ struct Run {
     status: Vec<(String, i64)>,
 }
 
+impl Seen {
+    fn new() -> Seen {
+        Seen {
+            latency_us: Stats::histogram(),
+            received: 0,
+        }
+    }
+
+    fn add(&mut self, other: &Seen) {
+        self.received += other.received;
+        // Same bounds on both sides, so adding never fails.
+        let _ = self.latency_us.add(&other.latency_us);
+    }
+}
+
 impl Run {
+    /// Adds a later round; its `/status` replaces this one's.
+    fn add(&mut self, later: Run) {
+        self.seen.add(&later.seen);
+        self.sent += later.sent;
+        self.status = later.status;
+    }
+
     fn get(&self, name: &str) -> i64 {
         self.status
             .iter()
@@ -69,14 +96,20 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         .enable_all()
         .build()
         .context("starting the tokio runtime")?;
-    let secs = Duration::from_secs_f64(args.seconds);
+    let rounds = (args.seconds / ROUND.as_secs_f64()).ceil().max(1.0) as u32;
+    let per_round = Duration::from_secs_f64(args.seconds) / rounds;
+    let (n, k) = (args.performers, args.clients);
     let (daemon, relay, max) = runtime.block_on(async {
-        let daemon = through_daemon(&model, args.performers, args.clients, 120.0, secs).await?;
-        let relay = through_relay(&model, args.performers, args.clients, secs).await?;
+        let mut daemon = through_daemon(&model, n, k, 120.0, per_round).await?;
+        let mut relay = through_relay(&model, n, k, per_round).await?;
+        for _ in 1..rounds {
+            daemon.add(through_daemon(&model, n, k, 120.0, per_round).await?);
+            relay.add(&through_relay(&model, n, k, per_round).await?);
+        }
         let max = through_daemon(&model, 1, 1, MAX_RATE_HZ, Duration::from_secs(1)).await?;
         anyhow::Ok((daemon, relay, max))
     })?;
-    let sent = (args.performers as f64 * 120.0 * args.seconds).round() as u64 * args.clients as u64;
+    let sent = daemon.sent * k as u64;
     crate::out!(
         "paced: {} performers x 120 Hz, {} clients, {} s, {MARKERS} markers, m = {COMPONENTS}",
         args.performers,
@@ -231,10 +264,7 @@ async fn receivers(k: usize) -> Result<(Receivers, Vec<SocketAddr>)> {
 }
 
 async fn receive(sock: UdpSocket, stop: CancellationToken) -> Seen {
-    let mut seen = Seen {
-        latency_us: Stats::histogram(),
-        received: 0,
-    };
+    let mut seen = Seen::new();
     let mut buf = vec![0u8; 65_536];
     let mut frame = FrameBuf::with_max_markers(MARKERS);
     loop {
@@ -260,15 +290,11 @@ async fn receive(sock: UdpSocket, stop: CancellationToken) -> Seen {
 }
 
 async fn collect(receivers: Receivers) -> Seen {
-    let mut all = Seen {
-        latency_us: Stats::histogram(),
-        received: 0,
-    };
+    let mut all = Seen::new();
     for (task, stop) in receivers {
         stop.cancel();
         if let Ok(s) = task.await {
-            all.received += s.received;
-            let _ = all.latency_us.add(&s.latency_us);
+            all.add(&s);
         }
     }
     all
