@@ -157,6 +157,15 @@ impl FrameBuf {
                 got: positions.len(),
             });
         }
+        if all_finite(positions) {
+            // the common case (an edited or synthetic frame, nothing missing): one copy
+            let n = positions.len() / 3;
+            self.reset_empty(n, FrameForm::Flat)?;
+            self.set_header(frame_number, capture_time_us);
+            self.positions.extend_from_slice(positions);
+            self.missing.resize(n.div_ceil(8), 0);
+            return Ok(());
+        }
         self.reset(positions.len() / 3, FrameForm::Flat)?;
         self.set_header(frame_number, capture_time_us);
         for (m, xyz) in positions.chunks_exact(3).enumerate() {
@@ -273,7 +282,7 @@ fn decode_blob_form(r: &mut Reader<'_>, buf: &mut FrameBuf) -> Result<(), Decode
     // convert every coordinate in one tight loop (it vectorises), then fix up and validate
     be_f32s_into(coords, &mut buf.positions);
     let all_present = mask.iter().all(|&b| b == 0);
-    if all_present && buf.positions.iter().all(|v| v.is_finite()) {
+    if all_present && all_finite(&buf.positions) {
         return Ok(());
     }
     let mut missing = 0;
@@ -308,7 +317,7 @@ fn decode_flat_form(
     buf.set_header(frame_number, capture_time_us);
     buf.missing.resize(n.div_ceil(8), 0);
     be_f32s_into(coords, &mut buf.positions);
-    if buf.positions.iter().all(|v| v.is_finite()) {
+    if all_finite(&buf.positions) {
         return Ok(());
     }
     for m in 0..n {
@@ -333,6 +342,25 @@ fn be_f32s_into(bytes: &[u8], out: &mut Vec<f32>) {
     for (d, c) in out[at..].iter_mut().zip(bytes.chunks_exact(4)) {
         *d = f32::from_be_bytes([c[0], c[1], c[2], c[3]]);
     }
+}
+
+/// Whether every value is finite. No early exit, and integer arithmetic on the exponent bits,
+/// so the loop vectorises on baseline SSE2; `iter().all(is_finite)` stops at
+/// the first bad value and runs one scalar compare and branch per float (~0.1 µs a 109-marker
+/// frame, measured, where this takes a fifth of that).
+pub(crate) fn all_finite(values: &[f32]) -> bool {
+    const EXP: u32 = 0x7f80_0000;
+    let chunks = values.chunks_exact(8);
+    let tail = chunks.remainder().iter().all(|v| v.is_finite());
+    // An all-ones exponent (Inf, NaN) plus its lowest bit carries into bit 31; any other
+    // exponent stays below it. Mask, add, or: three plain vector ops per four floats.
+    let mut bits = [0_u32; 8];
+    for c in chunks {
+        for i in 0..8 {
+            bits[i] |= (c[i].to_bits() & EXP) + 0x0080_0000;
+        }
+    }
+    tail && bits.iter().fold(0, |a, b| a | b) >> 31 == 0
 }
 
 /// Bytes of a `,ihbb` frame message with `markers` markers (1,368 for 109).
@@ -380,7 +408,7 @@ pub(crate) fn append_frame(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<(), En
             }
         }
     }
-    if !frame.positions.iter().all(|v| v.is_finite()) {
+    if !all_finite(&frame.positions) {
         let bad = frame
             .positions
             .chunks_exact(3)
@@ -420,4 +448,29 @@ pub fn encode_frame_flat_into(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<usi
         }
     }
     Ok(out.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::all_finite;
+
+    #[test]
+    fn all_finite_finds_any_bad_value_in_lanes_and_tail() {
+        for len in 0..21 {
+            let mut v: Vec<f32> = (0..len).map(|i| i as f32 - 7.5).collect();
+            v.iter_mut().take(1).for_each(|x| *x = f32::MAX);
+            v.iter_mut()
+                .skip(1)
+                .take(1)
+                .for_each(|x| *x = -f32::MIN_POSITIVE / 2.0);
+            assert!(all_finite(&v), "len {len}");
+            for at in 0..len {
+                for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+                    let mut w = v.clone();
+                    w[at] = bad;
+                    assert!(!all_finite(&w), "len {len}, {bad} at {at}");
+                }
+            }
+        }
+    }
 }
