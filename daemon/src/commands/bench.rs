@@ -11,7 +11,7 @@
 //! Bounded in time, only 127.0.0.1.
 
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -27,7 +27,7 @@ use tokio_util::sync::CancellationToken;
 
 use crate::cli::BenchArgs;
 use crate::serve::config::RawConfig;
-use crate::serve::net::bind_receiver;
+use crate::serve::net::{bind_receiver, bind_receiver_std};
 use crate::serve::pipeline::{Pipeline, PipelineConfig};
 use crate::serve::stats::Stats;
 use crate::serve::synthetic::{frame_into, labels_datagram, random_model};
@@ -91,8 +91,8 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         .into());
     }
     let model = random_model(MARKERS, COMPONENTS, 1);
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
+    // Senders and receivers on one thread; the daemon and the relay each on their own.
+    let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
         .context("starting the tokio runtime")?;
@@ -180,6 +180,54 @@ async fn status(control: SocketAddr) -> Result<Vec<(String, i64)>> {
     }
 }
 
+/// The daemon as `emoshift serve` runs it: its own runtime (two workers, as `serve`) and its
+/// processing thread, apart from the harness's thread.
+struct Daemon {
+    frames: SocketAddr,
+    control: SocketAddr,
+    shutdown: CancellationToken,
+    thread: std::thread::JoinHandle<Result<()>>,
+}
+
+impl Daemon {
+    async fn start(config: crate::serve::Config, model: IcaModel) -> Result<Daemon> {
+        let (tx, rx) = tokio::sync::oneshot::channel();
+        let shutdown = CancellationToken::new();
+        let token = shutdown.clone();
+        let thread = std::thread::spawn(move || -> Result<()> {
+            let runtime = tokio::runtime::Builder::new_multi_thread()
+                .worker_threads(2)
+                .enable_all()
+                .build()?;
+            runtime.block_on(async move {
+                let bound = crate::serve::bind_with(config, model).await;
+                let addrs = bound
+                    .as_ref()
+                    .map_err(|e| anyhow::anyhow!("{e:#}"))
+                    .and_then(|b| Ok((b.frame_addr()?, b.control_addr()?)));
+                let _ = tx.send(addrs);
+                bound?.run(token).await
+            })
+        });
+        let (frames, control) = rx.await.context("the daemon thread ended")??;
+        Ok(Daemon {
+            frames,
+            control,
+            shutdown,
+            thread,
+        })
+    }
+
+    async fn stop(self) -> Result<()> {
+        self.shutdown.cancel();
+        let thread = self.thread;
+        tokio::task::spawn_blocking(move || thread.join())
+            .await
+            .context("joining the daemon")?
+            .map_err(|_| anyhow::anyhow!("the daemon panicked"))?
+    }
+}
+
 /// Paced traffic through the daemon.
 async fn through_daemon(
     model: &IcaModel,
@@ -198,17 +246,11 @@ async fn through_daemon(
         ..RawConfig::default()
     };
     raw.send = addrs.iter().map(|a| a.to_string()).collect();
-    let config = raw.validate()?;
-    let bound = crate::serve::bind_with(config, model.clone()).await?;
-    let to = bound.frame_addr()?;
-    let control = bound.control_addr()?;
-    let shutdown = CancellationToken::new();
-    let server = tokio::spawn(bound.run(shutdown.clone()));
-    let sent = send_all(model, performers, to, rate_hz, secs).await?;
+    let daemon = Daemon::start(raw.validate()?, model.clone()).await?;
+    let sent = send_all(model, performers, daemon.frames, rate_hz, secs).await?;
     tokio::time::sleep(Duration::from_millis(200)).await;
-    let status = status(control).await?;
-    shutdown.cancel();
-    server.await.context("daemon task")??;
+    let status = status(daemon.control).await?;
+    daemon.stop().await?;
     Ok(Run {
         seen: collect(receivers).await,
         sent,
@@ -216,7 +258,8 @@ async fn through_daemon(
     })
 }
 
-/// The same traffic through a minimal relay.
+/// The same traffic through a minimal relay: one thread, blocking receive, the same bytes
+/// sent to every receiver (what `socat` does).
 async fn through_relay(
     model: &IcaModel,
     performers: usize,
@@ -224,26 +267,29 @@ async fn through_relay(
     secs: Duration,
 ) -> Result<Seen> {
     let (receivers, addrs) = receivers(clients).await?;
-    let relay = bind_receiver(([127, 0, 0, 1], 0).into())?;
+    let relay = bind_receiver_std(([127, 0, 0, 1], 0).into())?;
+    relay.set_read_timeout(Some(Duration::from_millis(20)))?;
     let to = relay.local_addr()?;
-    let stop = CancellationToken::new();
-    let stop2 = stop.clone();
-    let task = tokio::spawn(async move {
-        let mut buf = vec![0u8; 65_536];
-        loop {
-            let n = tokio::select! {
-                () = stop2.cancelled() => break,
-                r = relay.recv_from(&mut buf) => match r { Ok((n, _)) => n, Err(_) => continue },
+    let stop = Arc::new(AtomicBool::new(false));
+    let stop2 = Arc::clone(&stop);
+    let thread = std::thread::spawn(move || {
+        let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD];
+        while !stop2.load(Ordering::Relaxed) {
+            let Ok((n, _)) = relay.recv_from(&mut buf) else {
+                continue;
             };
             for a in &addrs {
-                let _ = relay.send_to(&buf[..n], a).await;
+                let _ = relay.send_to(&buf[..n], a);
             }
         }
     });
     send_all(model, performers, to, 120.0, secs).await?;
     tokio::time::sleep(Duration::from_millis(200)).await;
-    stop.cancel();
-    task.await.context("relay task")?;
+    stop.store(true, Ordering::Relaxed);
+    tokio::task::spawn_blocking(move || thread.join())
+        .await
+        .context("joining the relay")?
+        .map_err(|_| anyhow::anyhow!("the relay panicked"))?;
     Ok(collect(receivers).await)
 }
 
@@ -306,7 +352,10 @@ fn epoch_us() -> u64 {
     EPOCH.get_or_init(Instant::now).elapsed().as_micros() as u64
 }
 
-/// N senders at `rate_hz` on absolute deadlines for `secs`; returns frames sent.
+/// N performers at `rate_hz` for `secs`, on absolute deadlines like a stage: one thread sends
+/// every performer's frame on each tick, from its own socket, sleeping then spinning the last
+/// moments like `emoshift replay` (a tokio timer would bunch the sends into milliseconds).
+/// Returns frames sent.
 async fn send_all(
     model: &IcaModel,
     performers: usize,
@@ -314,41 +363,39 @@ async fn send_all(
     rate_hz: f64,
     secs: Duration,
 ) -> Result<u64> {
-    let total = Arc::new(AtomicU64::new(0));
-    let mut tasks = Vec::with_capacity(performers);
-    let frames = (rate_hz * secs.as_secs_f64()) as u64;
+    let labels = labels_datagram(model)?;
+    let mut sources = Vec::with_capacity(performers);
     for p in 0..performers {
-        let sock = UdpSocket::bind("127.0.0.1:0").await?;
-        let labels = labels_datagram(model)?;
-        sock.send_to(&labels, to).await?;
+        let sock = std::net::UdpSocket::bind("127.0.0.1:0")?;
+        sock.send_to(&labels, to)?;
         let mut xyz = vec![0.0f32; MARKERS * 3];
         frame_into(model, p, &mut xyz);
-        let total = Arc::clone(&total);
-        tasks.push(tokio::spawn(async move {
-            tokio::time::sleep(Duration::from_millis(20)).await;
-            let period = Duration::from_secs_f64(1.0 / rate_hz);
-            let start = tokio::time::Instant::now();
-            let mut buf = FrameBuf::with_max_markers(MARKERS);
-            let mut out = Vec::with_capacity(2048);
-            for n in 0..frames {
-                let due = start + period.mul_f64(n as f64);
-                if due > tokio::time::Instant::now() {
-                    tokio::time::sleep_until(due).await;
-                }
+        sources.push((sock, xyz));
+    }
+    let frames = (rate_hz * secs.as_secs_f64()) as u64;
+    let period = Duration::from_secs_f64(1.0 / rate_hz);
+    let thread = tokio::task::spawn_blocking(move || {
+        let never = AtomicBool::new(false);
+        std::thread::sleep(Duration::from_millis(20));
+        let start = Instant::now();
+        let mut buf = FrameBuf::with_max_markers(MARKERS);
+        let mut out = Vec::with_capacity(2048);
+        let mut sent = 0u64;
+        for n in 0..frames {
+            super::replay::wait_until(start + period.mul_f64(n as f64), &never);
+            for (sock, xyz) in &sources {
                 let t = epoch_us() as i64;
-                if buf.set_frame(n as i32, t, &xyz).is_ok()
+                if buf.set_frame(n as i32, t, xyz).is_ok()
                     && encode_frame_into(&buf, &mut out).is_ok()
+                    && sock.send_to(&out, to).is_ok()
                 {
-                    let _ = sock.send_to(&out, to).await;
-                    total.fetch_add(1, Ordering::Relaxed);
+                    sent += 1;
                 }
             }
-        }));
-    }
-    for t in tasks {
-        t.await.context("sender task")?;
-    }
-    Ok(total.load(Ordering::Relaxed))
+        }
+        sent
+    });
+    thread.await.context("sender thread")
 }
 
 /// Frames through one [`Pipeline`] back to back: median µs/frame over batches, frames/s.

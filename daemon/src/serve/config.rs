@@ -15,6 +15,9 @@ pub const DEFAULT_LISTEN: &str = "127.0.0.1:9000";
 pub const DEFAULT_CONTROL: &str = "127.0.0.1:9001";
 /// Default frames queued for the processing thread (latest frame wins past it).
 pub const DEFAULT_QUEUE: usize = 64;
+/// Default polling window around a steady source's expected arrival, µs (see
+/// [`super::arrival`]).
+pub const DEFAULT_POLL_WINDOW_US: u64 = 200;
 /// Default interval between status log lines.
 pub const DEFAULT_STATS_INTERVAL_S: f64 = 5.0;
 
@@ -56,6 +59,8 @@ pub struct RawConfig {
     pub lowpass_s: Option<f32>,
     /// Frames queued for processing.
     pub queue: Option<usize>,
+    /// Polling window around the expected arrival, µs; 0 always parks.
+    pub poll_window_us: Option<u64>,
     /// Seconds between status log lines.
     pub stats_interval_s: Option<f64>,
     /// Named performers.
@@ -98,6 +103,8 @@ pub struct Config {
     pub lowpass_s: f32,
     /// Processing queue length.
     pub queue: usize,
+    /// Polling window around a steady source's expected arrival.
+    pub poll_window: Duration,
     /// Status log interval.
     pub stats_interval: Duration,
     /// Performers.
@@ -181,6 +188,13 @@ impl RawConfig {
             queue.to_string(),
             "1..=65536",
         )?;
+        let poll_window_us = self.poll_window_us.unwrap_or(DEFAULT_POLL_WINDOW_US);
+        range(
+            "poll_window_us",
+            poll_window_us <= 1_000,
+            poll_window_us.to_string(),
+            "0..=1000",
+        )?;
         let stats = self.stats_interval_s.unwrap_or(DEFAULT_STATS_INTERVAL_S);
         range(
             "stats_interval_s",
@@ -229,6 +243,7 @@ impl RawConfig {
                 .unwrap_or(super::clients::DEFAULT_MAX_FAILURES),
             lowpass_s,
             queue,
+            poll_window: Duration::from_micros(poll_window_us),
             stats_interval: Duration::from_secs_f64(stats),
             performers,
         })
@@ -308,6 +323,16 @@ mod tests {
             .expect_err("negative")
             .to_string()
             .contains("lowpass_s"));
+        let raw = RawConfig {
+            model: Some("m".into()),
+            poll_window_us: Some(5_000),
+            ..RawConfig::default()
+        };
+        assert!(raw
+            .validate()
+            .expect_err("a 5 ms window would poll most of the period")
+            .to_string()
+            .contains("poll_window_us"));
         assert_eq!(RawConfig::default().validate(), Err(ConfigError::NoModel));
     }
 }

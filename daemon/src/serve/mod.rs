@@ -8,6 +8,8 @@
 //! - [`streams`]: one stream per source address and layout id, performers;
 //! - [`clients`]: subscribers, sans-IO; [`stats`]: counters and histograms;
 //! - [`record`]: recordings; [`synthetic`]: models and frames for bench and tests;
+//! - [`arrival`]: when the processing thread polls instead of parking (a steady source's
+//!   beat);
 //! - [`net`]: sockets (large receive buffers, connected senders);
 //! - `server`, `control`: the tasks, the only code that awaits; `sender`: the fan-out to the
 //!   subscribers, run on the processing thread.
@@ -15,6 +17,7 @@
 //! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
 //! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).
 
+pub mod arrival;
 pub mod clients;
 pub mod config;
 mod control;

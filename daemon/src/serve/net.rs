@@ -10,12 +10,22 @@ use socket2::{Domain, Protocol, Socket, Type};
 /// of ~208 KiB holds fewer than 100 frames of 109 markers and overflows silently.
 pub const RECV_BUFFER_BYTES: usize = 4 << 20;
 
-/// A non-blocking UDP socket bound to `addr` with a [`RECV_BUFFER_BYTES`] receive buffer (or
-/// the most the kernel grants: logged when less).
+/// A non-blocking tokio UDP socket bound to `addr` with a [`RECV_BUFFER_BYTES`] receive
+/// buffer (or the most the kernel grants: logged when less).
 ///
 /// # Errors
 /// The socket cannot be created or bound.
 pub fn bind_receiver(addr: SocketAddr) -> std::io::Result<tokio::net::UdpSocket> {
+    let s = bind_receiver_std(addr)?;
+    s.set_nonblocking(true)?;
+    tokio::net::UdpSocket::from_std(s)
+}
+
+/// [`bind_receiver`] as a blocking std socket.
+///
+/// # Errors
+/// The socket cannot be created or bound.
+pub fn bind_receiver_std(addr: SocketAddr) -> std::io::Result<std::net::UdpSocket> {
     let s = Socket::new(Domain::for_address(addr), Type::DGRAM, Some(Protocol::UDP))?;
     if let Err(e) = s.set_recv_buffer_size(RECV_BUFFER_BYTES) {
         tracing::warn!(%addr, error = %e, "cannot enlarge the receive buffer");
@@ -31,8 +41,7 @@ pub fn bind_receiver(addr: SocketAddr) -> std::io::Result<tokio::net::UdpSocket>
         );
     }
     s.bind(&addr.into())?;
-    s.set_nonblocking(true)?;
-    tokio::net::UdpSocket::from_std(s.into())
+    Ok(s.into())
 }
 
 /// A non-blocking std socket connected to `addr` (so an ICMP port unreachable comes back as a

@@ -24,6 +24,7 @@ use tokio::sync::oneshot;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
+use super::arrival::{ArrivalClock, SpinWindow, Wait};
 use super::control::{self, Cmd, ControlCtx};
 use super::pipeline::{Emitted, Pipeline, PipelineConfig};
 use super::record::Recording;
@@ -38,6 +39,8 @@ use super::Config;
 const MERGE_EVERY: Duration = Duration::from_millis(100);
 /// ... and at least this often under sustained load, when the queue is never empty.
 const MERGE_AT_LEAST: Duration = Duration::from_secs(1);
+/// The processing thread parks at most this long between two looks at its counters.
+const IDLE: Duration = Duration::from_millis(50);
 /// Pooled buffers kept for received datagrams.
 const POOL: usize = 256;
 
@@ -153,9 +156,14 @@ impl Bound {
         );
         let fanout = Fanout::new(&self.config)?;
         pipeline.set_wanted(fanout.wanted());
+        let window = self.config.poll_window;
         let processing = Processing {
             pipeline,
             fanout,
+            arrival: ArrivalClock::new(SpinWindow {
+                lead: window,
+                grace: window,
+            }),
             frame_rx: frame_rx.clone(),
             free_tx,
             cmd_rx,
@@ -245,6 +253,7 @@ async fn receive(
 struct Processing {
     pipeline: Pipeline,
     fanout: Fanout,
+    arrival: ArrivalClock,
     frame_rx: Receiver<InFrame>,
     free_tx: Sender<Vec<u8>>,
     cmd_rx: Receiver<Cmd>,
@@ -258,9 +267,21 @@ impl Processing {
     fn run(mut self) -> Result<()> {
         let mut last_merge = Instant::now();
         loop {
+            let now = Instant::now();
+            // `idle`: the timeout below means nothing came for a while (not a planned wake-up
+            // before the next beat), a good moment for the counters.
+            let (timeout, idle) = match self.arrival.plan(now) {
+                Wait::PollUntil(until) => {
+                    self.poll_until(until);
+                    (IDLE, true)
+                }
+                Wait::ParkUntil(at) => ((at - now).min(IDLE), false),
+                Wait::Park => (IDLE, true),
+            };
             crossbeam_channel::select! {
                 recv(self.frame_rx) -> msg => match msg {
                     Ok(frame) => {
+                        self.arrival.frame_arrived(frame.received);
                         self.process(frame);
                         let since = last_merge.elapsed();
                         if since >= MERGE_AT_LEAST
@@ -278,11 +299,11 @@ impl Processing {
                     // So that a `/status` right after a command sees its effect.
                     self.merge_stats();
                 },
-                default(Duration::from_millis(50)) => {
+                default(timeout) => if idle {
                     self.merge_stats();
                     self.housekeeping();
                     last_merge = Instant::now();
-                }
+                },
             }
         }
         self.merge_stats();
@@ -290,6 +311,12 @@ impl Processing {
             finish_recording(rec);
         }
         Ok(())
+    }
+
+    /// Polls the queues until something comes or `until`. No `spin_loop` hint: a hypervisor
+    /// may take a run of PAUSE instructions as lock contention and deschedule the CPU.
+    fn poll_until(&self, until: Instant) {
+        while self.frame_rx.is_empty() && self.cmd_rx.is_empty() && Instant::now() < until {}
     }
 
     fn process(&mut self, frame: InFrame) {

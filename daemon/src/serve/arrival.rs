@@ -1,0 +1,188 @@
+//! When the processing thread should poll for the next frame instead of parking, sans-IO.
+//!
+//! Waking a parked thread costs 30-50 µs on a virtual machine (the idle CPU must be
+//! interrupted and rescheduled), more than the whole frame path: with a receive task and a
+//! processing thread, a frame pays that twice where a relay pays it once. But a stage sends
+//! on a steady clock (cameras are genlocked), so the next frame's arrival is predictable. The
+//! thread parks until [`SpinWindow::lead`] before it and then polls the queue until it comes,
+//! or until [`SpinWindow::grace`] after it; anything off the beat is received the ordinary
+//! way. The window is skipped when it would take more than [`MAX_DUTY`] of the period, so
+//! unsteady or interleaved sources cost no CPU.
+//!
+//! Call order: [`ArrivalClock::frame_arrived`] with each frame's receive time,
+//! [`ArrivalClock::plan`] whenever the queue is empty.
+
+use std::time::{Duration, Instant};
+
+/// Frames closer than this to the first frame of a burst belong to it (several performers
+/// sent on the same tick).
+pub const BURST: Duration = Duration::from_millis(1);
+/// Periods outside this range are not a capture rate (a pause, a restart): ignored.
+pub const PERIODS: (Duration, Duration) = (Duration::from_millis(2), Duration::from_millis(50));
+/// The polling window may take at most this share of the period.
+pub const MAX_DUTY: f64 = 0.1;
+
+/// How long to poll around the expected arrival.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SpinWindow {
+    /// Polling starts this long before the expected arrival (covers a timed wake-up's
+    /// lateness); zero turns polling off.
+    pub lead: Duration,
+    /// ... and lasts until this long after it (covers the source's jitter).
+    pub grace: Duration,
+}
+
+impl SpinWindow {
+    /// Polling off: always park.
+    pub const OFF: SpinWindow = SpinWindow {
+        lead: Duration::ZERO,
+        grace: Duration::ZERO,
+    };
+}
+
+/// What the processing thread should do while its queue is empty.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wait {
+    /// Park until a frame or a command comes.
+    Park,
+    /// Park, but wake by this instant to start polling.
+    ParkUntil(Instant),
+    /// Poll the queue until this instant.
+    PollUntil(Instant),
+}
+
+/// The beat of the incoming frames. See the module docs.
+#[derive(Debug, Clone)]
+pub struct ArrivalClock {
+    window: SpinWindow,
+    burst_start: Option<Instant>,
+    period: Option<Duration>,
+}
+
+impl ArrivalClock {
+    /// A clock polling within `window`.
+    pub fn new(window: SpinWindow) -> ArrivalClock {
+        ArrivalClock {
+            window,
+            burst_start: None,
+            period: None,
+        }
+    }
+
+    /// The period learned so far.
+    pub fn period(&self) -> Option<Duration> {
+        self.period
+    }
+
+    /// A frame was received at `at`.
+    pub fn frame_arrived(&mut self, at: Instant) {
+        let Some(start) = self.burst_start else {
+            self.burst_start = Some(at);
+            return;
+        };
+        let gap = at.saturating_duration_since(start);
+        if gap < BURST {
+            return;
+        }
+        self.burst_start = Some(at);
+        if gap < PERIODS.0 || gap > PERIODS.1 {
+            return;
+        }
+        // Exponential average over ~8 bursts: follows a rate change within a tenth of a
+        // second at 120 Hz and smooths the source's jitter.
+        self.period = Some(match self.period {
+            None => gap,
+            Some(p) => (p * 7 + gap) / 8,
+        });
+    }
+
+    /// How to wait at `now` with an empty queue.
+    pub fn plan(&self, now: Instant) -> Wait {
+        let (Some(start), Some(period)) = (self.burst_start, self.period) else {
+            return Wait::Park;
+        };
+        let SpinWindow { lead, grace } = self.window;
+        if lead.is_zero() || (lead + grace).as_secs_f64() > period.as_secs_f64() * MAX_DUTY {
+            return Wait::Park;
+        }
+        let expected = start + period;
+        if now + lead < expected {
+            Wait::ParkUntil(expected - lead)
+        } else if now < expected + grace {
+            Wait::PollUntil(expected + grace)
+        } else {
+            Wait::Park
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const WINDOW: SpinWindow = SpinWindow {
+        lead: Duration::from_micros(200),
+        grace: Duration::from_micros(200),
+    };
+
+    fn us(n: u64) -> Duration {
+        Duration::from_micros(n)
+    }
+
+    #[test]
+    fn a_steady_source_is_polled_for_just_around_its_beat() {
+        let t0 = Instant::now();
+        let mut c = ArrivalClock::new(WINDOW);
+        assert_eq!(c.plan(t0), Wait::Park, "no beat yet");
+        let period = us(8_333);
+        for k in 0..20u32 {
+            // four performers on each tick, 20 µs apart
+            for p in 0..4u32 {
+                c.frame_arrived(t0 + period * k + us(20) * p);
+            }
+        }
+        let learned = c.period().expect("a period");
+        assert!(learned.abs_diff(period) < us(5), "{learned:?}");
+        let last = t0 + period * 19;
+        assert_eq!(
+            c.plan(last + us(100)),
+            Wait::ParkUntil(last + learned - us(200))
+        );
+        assert_eq!(
+            c.plan(last + learned - us(150)),
+            Wait::PollUntil(last + learned + us(200))
+        );
+        assert_eq!(c.plan(last + learned + us(250)), Wait::Park, "missed beat");
+    }
+
+    #[test]
+    fn jitter_is_averaged_and_pauses_are_ignored() {
+        let t0 = Instant::now();
+        let mut c = ArrivalClock::new(WINDOW);
+        let mut t = t0;
+        for k in 0..64u32 {
+            t += if k % 2 == 0 { us(8_000) } else { us(8_666) };
+            c.frame_arrived(t);
+        }
+        t += Duration::from_secs(2); // the performer stops, then resumes
+        c.frame_arrived(t);
+        let learned = c.period().expect("a period");
+        assert!(learned.abs_diff(us(8_333)) < us(200), "{learned:?}");
+    }
+
+    #[test]
+    fn polling_is_skipped_when_it_would_cost_too_much_or_is_off() {
+        let t0 = Instant::now();
+        let mut fast = ArrivalClock::new(WINDOW);
+        // interleaved sources: a frame every 2.5 ms, a 400 µs window would be 16 %
+        for k in 0..10u32 {
+            fast.frame_arrived(t0 + us(2_500) * k);
+        }
+        assert_eq!(fast.plan(t0 + us(2_500) * 9 + us(2_400)), Wait::Park);
+        let mut off = ArrivalClock::new(SpinWindow::OFF);
+        for k in 0..10u32 {
+            off.frame_arrived(t0 + us(8_333) * k);
+        }
+        assert_eq!(off.plan(t0 + us(8_333) * 9 + us(8_300)), Wait::Park);
+    }
+}
