@@ -125,8 +125,12 @@ impl FramePrep {
                 got: xyz.len(),
             });
         }
-        for (m, gone) in self.missing.iter_mut().enumerate() {
-            *gone = missing[m] || !xyz[m * 3..m * 3 + 3].iter().all(|v| v.is_finite());
+        if all_finite(xyz) {
+            self.missing.copy_from_slice(missing);
+        } else {
+            for (m, gone) in self.missing.iter_mut().enumerate() {
+                *gone = missing[m] || !xyz[m * 3..m * 3 + 3].iter().all(|v| v.is_finite());
+            }
         }
         let mut info = Prepared::default();
         let stabilised = match &mut self.stabiliser {
@@ -139,7 +143,10 @@ impl FramePrep {
                 true
             }
             None => {
-                self.head.copy_from_slice(xyz);
+                // only the glitch checks read `head`: without them the copy is wasted
+                if self.bounds.is_some() || self.max_step_mm.is_some() {
+                    self.head.copy_from_slice(xyz);
+                }
                 false
             }
         };
@@ -175,6 +182,10 @@ impl FramePrep {
     /// Marks samples that moved faster than the speed limit since their marker's last accepted
     /// sample (head coordinates, so head motion does not count) as missing.
     fn check_speed(&mut self) -> usize {
+        // Without a limit nothing reads the history below (`last`, the runs): skip the pass.
+        let Some(step) = self.max_step_mm else {
+            return 0;
+        };
         let mut glitches = 0;
         for m in 0..self.missing.len() {
             if self.missing[m] {
@@ -182,7 +193,7 @@ impl FramePrep {
                 continue;
             }
             let p = &self.head[m * 3..m * 3 + 3];
-            if let (Some(step), true) = (self.max_step_mm, self.last_known[m]) {
+            if self.last_known[m] {
                 let q = &self.last[m * 3..m * 3 + 3];
                 let d2: f32 = (0..3).map(|a| (p[a] - q[a]) * (p[a] - q[a])).sum();
                 // The allowance grows with the frames the marker was unseen, not with rejected
@@ -203,6 +214,24 @@ impl FramePrep {
         }
         glitches
     }
+}
+
+/// Whether every value is finite, without an early exit so it vectorises (integer arithmetic
+/// on the exponent bits, four lanes per SSE2 op): a clean frame is checked in one pass
+/// instead of a scalar test and branch per coordinate.
+fn all_finite(values: &[f32]) -> bool {
+    const EXP: u32 = 0x7f80_0000;
+    let chunks = values.chunks_exact(8);
+    let tail = chunks.remainder().iter().all(|v| v.is_finite());
+    // An all-ones exponent (Inf, NaN) plus its lowest bit carries into bit 31; any other
+    // exponent stays below it. Mask, add, or: three plain vector ops per four floats.
+    let mut bits = [0_u32; 8];
+    for c in chunks {
+        for i in 0..8 {
+            bits[i] |= (c[i].to_bits() & EXP) + 0x0080_0000;
+        }
+    }
+    tail && bits.iter().fold(0, |a, b| a | b) >> 31 == 0
 }
 
 /// Per-frame processor for one stream or take. See the module docs for the steps.
@@ -276,5 +305,60 @@ impl FrameProcessor {
             }
             None => self.projector.resynth_into(u, out),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn all_finite_finds_any_bad_value_in_lanes_and_tail() {
+        for len in 0..21 {
+            let v: Vec<f32> = (0..len).map(|i| i as f32 * 1e37 - 7.5).collect();
+            assert!(all_finite(&v), "len {len}");
+            for at in 0..len {
+                for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+                    let mut w = v.clone();
+                    w[at] = bad;
+                    assert!(!all_finite(&w), "len {len}, {bad} at {at}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn non_finite_samples_and_spikes_become_missing() {
+        let plain = CaptureSettings::default();
+        let mut prep = FramePrep::new(3, 100.0, &plain);
+        let mut xyz = [1.0_f32; 9];
+        let out = prep
+            .prepare(&xyz, &[false, true, false])
+            .expect("sizes match");
+        assert_eq!(out.missing, &[false, true, false]);
+        xyz[7] = f32::NAN;
+        let out = prep
+            .prepare(&xyz, &[false, false, false])
+            .expect("sizes match");
+        assert_eq!(
+            (out.missing, out.info.glitches),
+            (&[false, false, true][..], 0)
+        );
+
+        // 1 m/s at 100 Hz: 10 mm a frame.
+        let limited = CaptureSettings {
+            max_speed_mm_s: Some(1_000.0),
+            ..CaptureSettings::default()
+        };
+        let mut prep = FramePrep::new(3, 100.0, &limited);
+        let mut xyz = [0.0_f32; 9];
+        prep.prepare(&xyz, &[false; 3]).expect("sizes match");
+        xyz[3] = 50.0;
+        xyz[6] = 5.0;
+        let out = prep.prepare(&xyz, &[false; 3]).expect("sizes match");
+        assert_eq!(
+            (out.missing, out.info.glitches),
+            (&[false, true, false][..], 1)
+        );
     }
 }

@@ -25,6 +25,8 @@ pub struct LabelMap {
     pub model_to_take: Vec<Option<usize>>,
     /// Take markers the model does not know, in take order.
     pub extra: Vec<usize>,
+    /// Model marker `i` is take marker `i` for every `i`: a frame gathers with one copy.
+    identity: bool,
 }
 
 impl LabelMap {
@@ -46,9 +48,11 @@ impl LabelMap {
         let extra = (0..take.len())
             .filter(|t| !model_to_take.contains(&Some(*t)))
             .collect();
+        let identity = model_to_take.iter().enumerate().all(|(i, t)| *t == Some(i));
         Ok(LabelMap {
             model_to_take,
             extra,
+            identity,
         })
     }
 
@@ -81,6 +85,39 @@ impl LabelMap {
             }
         }
     }
+
+    /// [`LabelMap::gather_into`] for a take frame with no marker missing (the common live
+    /// case, known from the decoded header): no per-marker flag lookups, and a single copy
+    /// when the take has the model's order (the general loop was ~0.17 µs of a 2.6 µs live
+    /// frame at 109 markers, measured with perf).
+    ///
+    /// # Panics
+    /// If a buffer is shorter than the marker counts it was built for.
+    pub fn gather_present_into(&self, take_xyz: &[f32], xyz: &mut [f32], missing: &mut [bool]) {
+        if self.identity {
+            let n = self.model_to_take.len();
+            xyz.copy_from_slice(&take_xyz[..3 * n]);
+            missing.fill(false);
+            return;
+        }
+        for ((src, to), gone) in self
+            .model_to_take
+            .iter()
+            .zip(xyz.chunks_exact_mut(3))
+            .zip(missing.iter_mut())
+        {
+            match *src {
+                Some(t) => {
+                    to.copy_from_slice(&take_xyz[t * 3..t * 3 + 3]);
+                    *gone = false;
+                }
+                None => {
+                    to.fill(0.0);
+                    *gone = true;
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -104,6 +141,28 @@ mod tests {
         map.gather_into(&take, &[false, false, false], &mut xyz, &mut missing);
         assert_eq!(xyz, [3.0, 3.0, 3.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0]);
         assert_eq!(missing, [false, true, false]);
+        let (mut xyz2, mut missing2) = ([7.0; 9], [false; 3]);
+        map.gather_present_into(&take, &mut xyz2, &mut missing2);
+        assert_eq!((xyz2, missing2), (xyz, missing));
+    }
+
+    #[test]
+    fn same_order_gathers_like_the_general_path() {
+        let names = labels(&["a", "b", "c"]);
+        let map = LabelMap::new(&names, &names).expect("shared labels");
+        let take = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
+        let (mut fast, mut fast_missing) = ([0.0; 9], [true; 3]);
+        map.gather_present_into(&take, &mut fast, &mut fast_missing);
+        let (mut slow, mut slow_missing) = ([0.0; 9], [true; 3]);
+        map.gather_into(&take, &[false; 3], &mut slow, &mut slow_missing);
+        assert_eq!((fast, fast_missing), (take, [false; 3]));
+        assert_eq!((slow, slow_missing), (take, [false; 3]));
+        // A take with an extra marker first is not in model order.
+        let shifted = LabelMap::new(&names, &labels(&["x", "a", "b", "c"])).expect("shared");
+        let take4 = [0.0, 0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
+        let (mut xyz, mut missing) = ([0.0; 9], [true; 3]);
+        shifted.gather_present_into(&take4, &mut xyz, &mut missing);
+        assert_eq!((xyz, missing), (take, [false; 3]));
     }
 
     #[test]
