@@ -241,10 +241,29 @@ impl Pipeline {
             Err(e) => return self.counters.bad_packet(e.kind()),
         };
         self.counters.frames_in += 1;
-        let Some(key) = self.stream_for(peer, header.marker_count) else {
-            return;
+        // One lookup of the layout and one of the stream per frame (each a SipHash of the
+        // address): the labels found here also go out with the frame.
+        let Some(labels) = self.layouts.layout_for(&peer, header.marker_count) else {
+            return self.counters.dropped_no_layout += 1;
         };
-        let stream = self.streams.get_mut(&key).expect("stream_for created it");
+        let key = StreamKey {
+            source: peer,
+            layout_id: labels.layout_id,
+        };
+        let (performers, template) = (&self.performers, &self.template);
+        let (default_model, lowpass_s) = (&self.model, self.config.lowpass_s);
+        let Some(stream) = self.streams.get_or_create(key, || {
+            new_stream(
+                &key,
+                &labels.names,
+                performers,
+                default_model,
+                template,
+                lowpass_s,
+            )
+        }) else {
+            return self.counters.dropped_unmatched += 1;
+        };
         let frames = match stream.check_order(header.frame_number) {
             Order::Next { frames } => frames,
             Order::Restart => {
@@ -254,9 +273,6 @@ impl Pipeline {
             Order::Duplicate => return self.counters.dropped_duplicate += 1,
             Order::Stale => return self.counters.dropped_stale += 1,
         };
-        for (i, m) in stream.take_missing.iter_mut().enumerate() {
-            *m = self.frame_in.is_missing(i);
-        }
         let Stream {
             map,
             processor,
@@ -270,7 +286,14 @@ impl Pipeline {
             vmc,
             ..
         } = stream;
-        map.gather_into(self.frame_in.positions(), take_missing, xyz, missing);
+        if header.missing_count == 0 {
+            map.gather_present_into(self.frame_in.positions(), xyz, missing);
+        } else {
+            for (i, m) in take_missing.iter_mut().enumerate() {
+                *m = self.frame_in.is_missing(i);
+            }
+            map.gather_into(self.frame_in.positions(), take_missing, xyz, missing);
+        }
         self.counters.missing_markers += missing.iter().filter(|&&m| m).count() as u64;
         let prepared = match processor.project(xyz, missing, u) {
             Ok(p) => p,
@@ -318,55 +341,36 @@ impl Pipeline {
             components: &self.components,
             xyz: out,
             input: &self.frame_in,
-            input_labels: self
-                .layouts
-                .layout_for(&peer, header.marker_count)
-                .map_or(&[], |l| &l.names),
+            input_labels: &labels.names,
             labels: model.labels(),
             rate_hz: rate,
         });
     }
+}
 
-    /// The stream of a frame, created on its first frame; counts why a frame has none.
-    fn stream_for(&mut self, peer: SocketAddr, marker_count: usize) -> Option<StreamKey> {
-        let Some(labels) = self.layouts.layout_for(&peer, marker_count) else {
-            self.counters.dropped_no_layout += 1;
-            return None;
-        };
-        let key = StreamKey {
-            source: peer,
-            layout_id: labels.layout_id,
-        };
-        if self.streams.get_mut(&key).is_some() {
-            return Some(key);
-        }
-        let performer = self.performers.iter().position(|p| p.owns(&key));
-        let p = performer.map(|i| &self.performers[i]);
-        let model = p
-            .and_then(|p| p.model.clone())
-            .unwrap_or_else(|| Arc::clone(&self.model));
-        let created = Stream::new(
-            Arc::clone(&model),
-            performer,
-            &labels.names,
-            self.config.lowpass_s,
-        );
-        let Ok(mut stream) = created else {
-            self.counters.dropped_unmatched += 1;
-            return None;
-        };
-        if Arc::ptr_eq(&model, &self.model) {
-            stream.edit.copy_settings(&self.template);
-        }
-        if let Some(p) = p {
-            defaults_of(p, &mut stream);
-        }
-        if !self.streams.insert(key, stream) {
-            self.counters.dropped_unmatched += 1;
-            return None;
-        }
-        Some(key)
+/// A new stream for `key` on its performer's model (or the default one, with the template's
+/// edit settings); `None` when its labels share none with the model.
+fn new_stream(
+    key: &StreamKey,
+    source_labels: &[String],
+    performers: &[Performer],
+    default_model: &Arc<IcaModel>,
+    template: &super::edit_state::EditState,
+    lowpass_s: f32,
+) -> Option<Stream> {
+    let performer = performers.iter().position(|p| p.owns(key));
+    let p = performer.map(|i| &performers[i]);
+    let model = p
+        .and_then(|p| p.model.clone())
+        .unwrap_or_else(|| Arc::clone(default_model));
+    let mut stream = Stream::new(Arc::clone(&model), performer, source_labels, lowpass_s).ok()?;
+    if Arc::ptr_eq(&model, default_model) {
+        stream.edit.copy_settings(template);
     }
+    if let Some(p) = p {
+        defaults_of(p, &mut stream);
+    }
+    Some(stream)
 }
 
 /// A performer's default emotion, set at once (no ramp) on a new stream.

@@ -3,6 +3,7 @@
 //! a source and/or layout to a named model and default emotion; other streams use the loaded
 //! model.
 
+use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -216,6 +217,22 @@ impl Streams {
     /// The stream of `key`, if it exists.
     pub fn get_mut(&mut self, key: &StreamKey) -> Option<&mut Stream> {
         self.map.get_mut(key)
+    }
+
+    /// The stream of `key`, made by `create` when it does not exist yet: one hash lookup, where
+    /// `get_mut` then `insert` took two or three per frame. `None` when `create` gives none or
+    /// the cap is reached.
+    pub fn get_or_create(
+        &mut self,
+        key: StreamKey,
+        create: impl FnOnce() -> Option<Stream>,
+    ) -> Option<&mut Stream> {
+        let full = self.map.len() >= self.max_streams;
+        match self.map.entry(key) {
+            Entry::Occupied(e) => Some(e.into_mut()),
+            Entry::Vacant(_) if full => None,
+            Entry::Vacant(e) => Some(e.insert(create()?)),
+        }
     }
 
     /// Adds a stream; `false` when the cap is reached.
