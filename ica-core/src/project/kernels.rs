@@ -101,6 +101,18 @@ pub(crate) fn axpy4(a: [f32; 4], x: [&[f32]; 4], y: &mut [f32]) {
     }
 }
 
+/// `y = base + a0 x0 + a1 x1 + a2 x2 + a3 x3`: [`axpy4`] that starts from `base` instead of
+/// reading `y`, so resynthesis needs no separate copy of the mean (one pass over `y` fewer).
+#[inline]
+pub(crate) fn axpy4_onto(base: &[f32], a: [f32; 4], x: [&[f32]; 4], y: &mut [f32]) {
+    let n = y.len();
+    let (b, x0, x1, x2, x3) = (&base[..n], &x[0][..n], &x[1][..n], &x[2][..n], &x[3][..n]);
+    for j in 0..n {
+        // the sum first, as in axpy4 from a copy of `base`: bit-identical results
+        y[j] = b[j] + (a[0] * x0[j] + a[1] * x1[j] + a[2] * x2[j] + a[3] * x3[j]);
+    }
+}
+
 /// `out = a - b`.
 #[inline]
 pub(crate) fn sub_into(a: &[f32], b: &[f32], out: &mut [f32]) {
@@ -138,6 +150,14 @@ mod tests {
         for j in 0..n {
             assert!((y[j] - (b[j] + 3.0 * a[j] - b[j])).abs() < 1e-5);
         }
+        let mut z = vec![f32::NAN; n];
+        axpy4_onto(
+            &b,
+            [1.0, 2.0, 0.0, -1.0],
+            [&a[..], &a[..], &b[..], &b[..]],
+            &mut z,
+        );
+        assert_eq!(z, y);
         // One non-finite coordinate poisons every component (what project_masked_into's
         // fast path relies on), even where W is zero (the padded lanes here).
         let mut x = b.clone();

@@ -28,7 +28,7 @@ pub use masked::MIN_OBSERVABILITY;
 
 use crate::edit::FrameEdit;
 use crate::model::IcaModel;
-use kernels::{axpy, axpy4, panel_gemv, sub_into, PANEL_WIDTHS};
+use kernels::{axpy, axpy4, axpy4_onto, panel_gemv, sub_into, PANEL_WIDTHS};
 use masked::MaskedSolver;
 
 /// A frame buffer of the wrong length. Small and `Copy`: returned per frame.
@@ -200,15 +200,23 @@ impl Projector {
     pub fn resynth_into(&self, u: &[f32], out: &mut [f32]) -> Result<(), FrameError> {
         check_len("components", self.components, u.len())?;
         check_len("output", self.channels, out.len())?;
-        out.copy_from_slice(&self.mean);
         let n = self.channels;
         let mut cols = self.mixing.chunks_exact(4 * n);
         let mut uk = u.chunks_exact(4);
-        for (block, a) in (&mut cols).zip(&mut uk) {
+        if self.components < 4 {
+            out.copy_from_slice(&self.mean);
+        }
+        for (i, (block, a)) in (&mut cols).zip(&mut uk).enumerate() {
             let (c0, rest) = block.split_at(n);
             let (c1, rest) = rest.split_at(n);
             let (c2, c3) = rest.split_at(n);
-            axpy4([a[0], a[1], a[2], a[3]], [c0, c1, c2, c3], out);
+            let (a, c) = ([a[0], a[1], a[2], a[3]], [c0, c1, c2, c3]);
+            // The first four columns start from the mean: no separate copy pass.
+            if i == 0 {
+                axpy4_onto(&self.mean, a, c, out);
+            } else {
+                axpy4(a, c, out);
+            }
         }
         for (col, &a) in cols.remainder().chunks_exact(n).zip(uk.remainder()) {
             axpy(a, col, out);
