@@ -276,6 +276,9 @@ pub struct BenchArgs {
     /// Seconds of each timed run.
     #[arg(long, default_value_t = 3.0)]
     pub seconds: f64,
+    /// The daemon's `poll_window_us` (0: the processing thread always parks).
+    #[arg(long, default_value_t = crate::serve::config::DEFAULT_POLL_WINDOW_US)]
+    pub poll_window_us: u64,
 }
 
 /// A `k=value` pair of `--translate` and `--gain`.

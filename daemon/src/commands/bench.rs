@@ -100,13 +100,14 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let per_round = Duration::from_secs_f64(args.seconds) / rounds;
     let (n, k) = (args.performers, args.clients);
     let (daemon, relay, max) = runtime.block_on(async {
-        let mut daemon = through_daemon(&model, n, k, 120.0, per_round).await?;
+        let w = args.poll_window_us;
+        let mut daemon = through_daemon(&model, n, k, 120.0, per_round, w).await?;
         let mut relay = through_relay(&model, n, k, per_round).await?;
         for _ in 1..rounds {
-            daemon.add(through_daemon(&model, n, k, 120.0, per_round).await?);
+            daemon.add(through_daemon(&model, n, k, 120.0, per_round, w).await?);
             relay.add(&through_relay(&model, n, k, per_round).await?);
         }
-        let max = through_daemon(&model, 1, 1, MAX_RATE_HZ, Duration::from_secs(1)).await?;
+        let max = through_daemon(&model, 1, 1, MAX_RATE_HZ, Duration::from_secs(1), w).await?;
         anyhow::Ok((daemon, relay, max))
     })?;
     let sent = daemon.sent * k as u64;
@@ -125,6 +126,11 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         daemon.get("processed_p99_us"),
         daemon.get("sent_p50_us"),
         daemon.get("sent_p99_us"),
+    );
+    crate::out!(
+        "  frames caught by polling around the beat: {} of {} windows",
+        daemon.get("poll_hits"),
+        daemon.get("poll_hits") + daemon.get("poll_misses"),
     );
     for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999), ("max", 1.0)] {
         let d = daemon.seen.latency_us.value_at_quantile(q);
@@ -235,6 +241,7 @@ async fn through_daemon(
     clients: usize,
     rate_hz: f64,
     secs: Duration,
+    poll_window_us: u64,
 ) -> Result<Run> {
     let (receivers, addrs) = receivers(clients).await?;
     let mut raw = RawConfig {
@@ -242,6 +249,7 @@ async fn through_daemon(
         control: Some("127.0.0.1:0".into()),
         model: Some("unused".into()),
         queue: Some(1024),
+        poll_window_us: Some(poll_window_us),
         stats_interval_s: Some(3600.0),
         ..RawConfig::default()
     };
@@ -375,14 +383,14 @@ async fn send_all(
     let frames = (rate_hz * secs.as_secs_f64()) as u64;
     let period = Duration::from_secs_f64(1.0 / rate_hz);
     let thread = tokio::task::spawn_blocking(move || {
-        let never = AtomicBool::new(false);
         std::thread::sleep(Duration::from_millis(20));
         let start = Instant::now();
         let mut buf = FrameBuf::with_max_markers(MARKERS);
         let mut out = Vec::with_capacity(2048);
         let mut sent = 0u64;
         for n in 0..frames {
-            super::replay::wait_until(start + period.mul_f64(n as f64), &never);
+            let due = start + period.mul_f64(n as f64);
+            std::thread::sleep(due.saturating_duration_since(Instant::now()));
             for (sock, xyz) in &sources {
                 let t = epoch_us() as i64;
                 if buf.set_frame(n as i32, t, xyz).is_ok()

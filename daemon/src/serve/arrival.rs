@@ -51,11 +51,17 @@ pub enum Wait {
     PollUntil(Instant),
 }
 
+/// Gaps between ticks remembered; the period is their median, which ignores a stray gap
+/// (a start-up delay, a dropped frame) where an average would take many ticks to forget it.
+const GAPS: usize = 8;
+
 /// The beat of the incoming frames. See the module docs.
 #[derive(Debug, Clone)]
 pub struct ArrivalClock {
     window: SpinWindow,
     burst_start: Option<Instant>,
+    gaps: [Duration; GAPS],
+    gap_count: usize,
     period: Option<Duration>,
 }
 
@@ -65,6 +71,8 @@ impl ArrivalClock {
         ArrivalClock {
             window,
             burst_start: None,
+            gaps: [Duration::ZERO; GAPS],
+            gap_count: 0,
             period: None,
         }
     }
@@ -88,12 +96,12 @@ impl ArrivalClock {
         if gap < PERIODS.0 || gap > PERIODS.1 {
             return;
         }
-        // Exponential average over ~8 bursts: follows a rate change within a tenth of a
-        // second at 120 Hz and smooths the source's jitter.
-        self.period = Some(match self.period {
-            None => gap,
-            Some(p) => (p * 7 + gap) / 8,
-        });
+        self.gaps[self.gap_count % GAPS] = gap;
+        self.gap_count += 1;
+        let mut recent = self.gaps;
+        let recent = &mut recent[..self.gap_count.min(GAPS)];
+        recent.sort_unstable();
+        self.period = Some(recent[recent.len() / 2]);
     }
 
     /// How to wait at `now` with an empty queue.
@@ -156,7 +164,7 @@ mod tests {
     }
 
     #[test]
-    fn jitter_is_averaged_and_pauses_are_ignored() {
+    fn jitter_pauses_and_start_up_delays_do_not_throw_the_period_off() {
         let t0 = Instant::now();
         let mut c = ArrivalClock::new(WINDOW);
         let mut t = t0;
@@ -167,7 +175,14 @@ mod tests {
         t += Duration::from_secs(2); // the performer stops, then resumes
         c.frame_arrived(t);
         let learned = c.period().expect("a period");
-        assert!(learned.abs_diff(us(8_333)) < us(200), "{learned:?}");
+        assert!(learned.abs_diff(us(8_333)) <= us(333), "{learned:?}");
+        // A start-up delay is forgotten within a few ticks.
+        let mut c = ArrivalClock::new(WINDOW);
+        c.frame_arrived(t0);
+        for k in 0..5u32 {
+            c.frame_arrived(t0 + us(30_000) + us(8_333) * k);
+        }
+        assert_eq!(c.period(), Some(us(8_333)));
     }
 
     #[test]

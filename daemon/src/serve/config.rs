@@ -17,7 +17,7 @@ pub const DEFAULT_CONTROL: &str = "127.0.0.1:9001";
 pub const DEFAULT_QUEUE: usize = 64;
 /// Default polling window around a steady source's expected arrival, µs (see
 /// [`super::arrival`]).
-pub const DEFAULT_POLL_WINDOW_US: u64 = 200;
+pub const DEFAULT_POLL_WINDOW_US: u64 = 400;
 /// Default interval between status log lines.
 pub const DEFAULT_STATS_INTERVAL_S: f64 = 5.0;
 

@@ -162,8 +162,10 @@ impl Bound {
             fanout,
             arrival: ArrivalClock::new(SpinWindow {
                 lead: window,
-                grace: window,
+                grace: window / 2,
             }),
+            poll_hits: 0,
+            poll_misses: 0,
             frame_rx: frame_rx.clone(),
             free_tx,
             cmd_rx,
@@ -254,6 +256,8 @@ struct Processing {
     pipeline: Pipeline,
     fanout: Fanout,
     arrival: ArrivalClock,
+    poll_hits: u64,
+    poll_misses: u64,
     frame_rx: Receiver<InFrame>,
     free_tx: Sender<Vec<u8>>,
     cmd_rx: Receiver<Cmd>,
@@ -272,7 +276,11 @@ impl Processing {
             // before the next beat), a good moment for the counters.
             let (timeout, idle) = match self.arrival.plan(now) {
                 Wait::PollUntil(until) => {
-                    self.poll_until(until);
+                    if self.poll_until(until) {
+                        self.poll_hits += 1;
+                    } else {
+                        self.poll_misses += 1;
+                    }
                     (IDLE, true)
                 }
                 Wait::ParkUntil(at) => ((at - now).min(IDLE), false),
@@ -313,10 +321,18 @@ impl Processing {
         Ok(())
     }
 
-    /// Polls the queues until something comes or `until`. No `spin_loop` hint: a hypervisor
-    /// may take a run of PAUSE instructions as lock contention and deschedule the CPU.
-    fn poll_until(&self, until: Instant) {
-        while self.frame_rx.is_empty() && self.cmd_rx.is_empty() && Instant::now() < until {}
+    /// Polls the queues until something comes (`true`) or `until`. No `spin_loop` hint: a
+    /// hypervisor may take a run of PAUSE instructions as lock contention and deschedule the
+    /// CPU.
+    fn poll_until(&self, until: Instant) -> bool {
+        loop {
+            if !self.frame_rx.is_empty() || !self.cmd_rx.is_empty() {
+                return true;
+            }
+            if Instant::now() >= until {
+                return false;
+            }
+        }
     }
 
     fn process(&mut self, frame: InFrame) {
@@ -360,6 +376,7 @@ impl Processing {
         s.counters.dropped_queue_full = self.queue_dropped.load(Ordering::Relaxed);
         s.streams = self.pipeline.stream_count() as u64;
         s.send = self.fanout.counters.clone();
+        (s.poll_hits, s.poll_misses) = (self.poll_hits, self.poll_misses);
         s.clients = self.fanout.len() as u64;
         // Same bounds on both sides, so adding never fails.
         let _ = s.processed_us.add(&self.processed_us);

@@ -77,6 +77,10 @@ pub struct Stats {
     pub clients: u64,
     /// Streams now.
     pub streams: u64,
+    /// Polling windows in which a frame came (it was processed without a wake-up).
+    pub poll_hits: u64,
+    /// Polling windows that ended without a frame.
+    pub poll_misses: u64,
 }
 
 impl Default for Stats {
@@ -100,6 +104,8 @@ impl Stats {
             sent_us: Stats::histogram(),
             clients: 0,
             streams: 0,
+            poll_hits: 0,
+            poll_misses: 0,
         }
     }
 
@@ -133,6 +139,8 @@ impl Stats {
             ("dropped_send_buffer", self.send.dropped_send_buffer),
             ("clients", self.clients),
             ("streams", self.streams),
+            ("poll_hits", self.poll_hits),
+            ("poll_misses", self.poll_misses),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), i(v)))
