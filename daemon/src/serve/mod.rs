@@ -11,8 +11,8 @@
 //! - [`arrival`]: when the processing thread polls instead of parking (a steady source's
 //!   beat);
 //! - [`net`]: sockets (large receive buffers, connected senders);
-//! - `server`, `control`: the tasks, the only code that awaits; `sender`: the fan-out to the
-//!   subscribers, run on the processing thread.
+//! - `server`, `control`: the tasks, the only code that awaits; `processing`: the processing
+//!   thread; `sender`: its fan-out to the subscribers.
 //!
 //! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
 //! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).
@@ -24,6 +24,7 @@ mod control;
 pub mod edit_state;
 pub mod net;
 pub mod pipeline;
+mod processing;
 pub mod record;
 mod sender;
 mod server;

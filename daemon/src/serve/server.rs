@@ -2,9 +2,9 @@
 //!
 //! - **receive**: frame socket → pooled buffer → bounded crossbeam channel; when full the
 //!   oldest frame is dropped and counted (latest frame wins);
-//! - **processing** (one blocking thread): [`Pipeline`] per frame, then the encoded bytes
-//!   straight to every subscriber ([`Fanout`]), control commands (edits, subscriptions,
-//!   models, recordings) between frames, recording;
+//! - **processing** (one blocking thread, [`Processing`]): [`Pipeline`] per frame, then the
+//!   encoded bytes straight to every subscriber ([`Fanout`]), control commands (edits,
+//!   subscriptions, models, recordings) between frames, recording;
 //! - **control**: decodes control messages and answers them;
 //! - **stats**: logs the counters every few seconds; **SIGHUP** reloads the model.
 //!
@@ -24,33 +24,16 @@ use tokio::sync::oneshot;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
-use super::arrival::{ArrivalClock, SpinWindow, Wait};
 use super::control::{self, Cmd, ControlCtx};
-use super::pipeline::{Emitted, Pipeline, PipelineConfig};
-use super::record::Recording;
+use super::pipeline::{Pipeline, PipelineConfig};
+use super::processing::{Channels, InFrame, Processing};
 use super::sender::Fanout;
 use super::stats::Stats;
 use super::streams::Performer;
 use super::Config;
 
-/// The processing thread merges its counters and histograms into the shared [`Stats`] (a
-/// lock, a histogram add and reset: tens of µs) only between bursts: when its queue is empty
-/// and this long has passed since the last merge, after 50 ms idle, or after a command.
-const MERGE_EVERY: Duration = Duration::from_millis(100);
-/// ... and at least this often under sustained load, when the queue is never empty.
-const MERGE_AT_LEAST: Duration = Duration::from_secs(1);
-/// The processing thread parks at most this long between two looks at its counters.
-const IDLE: Duration = Duration::from_millis(50);
 /// Pooled buffers kept for received datagrams.
 const POOL: usize = 256;
-
-/// One received datagram.
-#[derive(Debug)]
-pub(crate) struct InFrame {
-    peer: SocketAddr,
-    bytes: Vec<u8>,
-    received: Instant,
-}
 
 /// A server with its sockets bound and its models loaded; [`Bound::run`] serves.
 #[derive(Debug)]
@@ -146,7 +129,7 @@ impl Bound {
         let (free_tx, free_rx) = crossbeam_channel::bounded::<Vec<u8>>(POOL);
         let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Cmd>(64);
 
-        let mut pipeline = Pipeline::new(
+        let pipeline = Pipeline::new(
             self.model,
             self.performers,
             PipelineConfig {
@@ -154,26 +137,17 @@ impl Bound {
                 ..PipelineConfig::default()
             },
         );
-        let fanout = Fanout::new(&self.config)?;
-        pipeline.set_wanted(fanout.wanted());
-        let window = self.config.poll_window;
-        let processing = Processing {
+        let processing = Processing::new(
             pipeline,
-            fanout,
-            arrival: ArrivalClock::new(SpinWindow {
-                lead: window,
-                grace: window / 2,
-            }),
-            poll_hits: 0,
-            poll_misses: 0,
-            frame_rx: frame_rx.clone(),
-            free_tx,
-            cmd_rx,
-            stats: Arc::clone(&stats),
-            queue_dropped: Arc::clone(&queue_dropped),
-            recording: None,
-            processed_us: Stats::histogram(),
-        };
+            Fanout::new(&self.config)?,
+            self.config.poll_window,
+            Channels {
+                frames: frame_rx.clone(),
+                free: free_tx,
+                commands: cmd_rx,
+            },
+            (Arc::clone(&stats), Arc::clone(&queue_dropped)),
+        );
         let processing = tracker.spawn_blocking(move || processing.run());
 
         let receive = receive(
@@ -202,7 +176,7 @@ impl Bound {
         tracker.close();
         let result = processing.await;
         tracker.wait().await;
-        result.context("processing thread panicked")?
+        result.context("processing thread panicked")
     }
 }
 
@@ -248,183 +222,6 @@ async fn receive(
                 Err(crossbeam_channel::TrySendError::Disconnected(_)) => return,
             }
         }
-    }
-}
-
-/// The processing thread's state.
-struct Processing {
-    pipeline: Pipeline,
-    fanout: Fanout,
-    arrival: ArrivalClock,
-    poll_hits: u64,
-    poll_misses: u64,
-    frame_rx: Receiver<InFrame>,
-    free_tx: Sender<Vec<u8>>,
-    cmd_rx: Receiver<Cmd>,
-    stats: Arc<Mutex<Stats>>,
-    queue_dropped: Arc<AtomicU64>,
-    recording: Option<Recording>,
-    processed_us: hdrhistogram::Histogram<u64>,
-}
-
-impl Processing {
-    fn run(mut self) -> Result<()> {
-        let mut last_merge = Instant::now();
-        loop {
-            let now = Instant::now();
-            // `idle`: the timeout below means nothing came for a while (not a planned wake-up
-            // before the next beat), a good moment for the counters.
-            let (timeout, idle) = match self.arrival.plan(now) {
-                Wait::PollUntil(until) => {
-                    if self.poll_until(until) {
-                        self.poll_hits += 1;
-                    } else {
-                        self.poll_misses += 1;
-                    }
-                    (IDLE, true)
-                }
-                Wait::ParkUntil(at) => ((at - now).min(IDLE), false),
-                Wait::Park => (IDLE, true),
-            };
-            crossbeam_channel::select! {
-                recv(self.frame_rx) -> msg => match msg {
-                    Ok(frame) => {
-                        self.arrival.frame_arrived(frame.received);
-                        self.process(frame);
-                        let since = last_merge.elapsed();
-                        if since >= MERGE_AT_LEAST
-                            || (since >= MERGE_EVERY && self.frame_rx.is_empty())
-                        {
-                            self.merge_stats();
-                            self.housekeeping();
-                            last_merge = Instant::now();
-                        }
-                    }
-                    Err(_) => break,
-                },
-                recv(self.cmd_rx) -> cmd => if let Ok(cmd) = cmd {
-                    self.command(cmd);
-                    // So that a `/status` right after a command sees its effect.
-                    self.merge_stats();
-                },
-                default(timeout) => if idle {
-                    self.merge_stats();
-                    self.housekeeping();
-                    last_merge = Instant::now();
-                },
-            }
-        }
-        self.merge_stats();
-        if let Some(rec) = self.recording.take() {
-            finish_recording(rec);
-        }
-        Ok(())
-    }
-
-    /// Polls the queues until something comes (`true`) or `until`. No `spin_loop` hint: a
-    /// hypervisor may take a run of PAUSE instructions as lock contention and deschedule the
-    /// CPU.
-    fn poll_until(&self, until: Instant) -> bool {
-        loop {
-            if !self.frame_rx.is_empty() || !self.cmd_rx.is_empty() {
-                return true;
-            }
-            if Instant::now() >= until {
-                return false;
-            }
-        }
-    }
-
-    fn process(&mut self, frame: InFrame) {
-        let Processing {
-            pipeline,
-            fanout,
-            recording,
-            processed_us,
-            ..
-        } = self;
-        let received = frame.received;
-        let mut clients_changed = false;
-        pipeline.handle_datagram(frame.peer, &frame.bytes, &mut |e: &Emitted<'_>| {
-            let processed = Instant::now();
-            Stats::record(
-                processed_us,
-                processed.duration_since(received).as_micros() as u64,
-            );
-            // Send before recording: the file write is not on the subscribers' path.
-            clients_changed |= fanout.send(e, processed);
-            if let Some(rec) = recording.as_mut() {
-                rec.push(e);
-            }
-        });
-        if clients_changed {
-            self.pipeline.set_wanted(self.fanout.wanted());
-        }
-        let _ = self.free_tx.try_send(frame.bytes);
-    }
-
-    /// Between frames: subscriptions whose lease ended.
-    fn housekeeping(&mut self) {
-        if self.fanout.expire(Instant::now()) {
-            self.pipeline.set_wanted(self.fanout.wanted());
-        }
-    }
-
-    fn merge_stats(&mut self) {
-        let Ok(mut s) = self.stats.lock() else { return };
-        s.counters = self.pipeline.counters.clone();
-        s.counters.dropped_queue_full = self.queue_dropped.load(Ordering::Relaxed);
-        s.streams = self.pipeline.stream_count() as u64;
-        s.send = self.fanout.counters.clone();
-        (s.poll_hits, s.poll_misses) = (self.poll_hits, self.poll_misses);
-        s.clients = self.fanout.len() as u64;
-        // Same bounds on both sides, so adding never fails.
-        let _ = s.processed_us.add(&self.processed_us);
-        self.processed_us.reset();
-        let _ = s.sent_us.add(&self.fanout.sent_us);
-        self.fanout.sent_us.reset();
-    }
-
-    fn command(&mut self, cmd: Cmd) {
-        match cmd {
-            Cmd::Edit(control, reply) => {
-                let r = self
-                    .pipeline
-                    .handle_edit(&control)
-                    .map_err(|e| e.to_string());
-                let _ = reply.send(r);
-            }
-            Cmd::Client(peer, control, reply) => {
-                let r = self.fanout.command(peer, &control);
-                self.pipeline.set_wanted(self.fanout.wanted());
-                let _ = reply.send(r);
-            }
-            Cmd::SetModel(model, reply) => {
-                self.pipeline.set_model(model);
-                let _ = reply.send(Ok(()));
-            }
-            Cmd::RecordStart(path, raw, reply) => {
-                if let Some(rec) = self.recording.take() {
-                    finish_recording(rec);
-                }
-                let r =
-                    Recording::start(&path, raw.as_deref()).map(|rec| self.recording = Some(rec));
-                let _ = reply.send(r.map_err(|e| e.to_string()));
-            }
-            Cmd::RecordStop(reply) => {
-                let r = match self.recording.take() {
-                    Some(rec) => rec.finish().map(|_| ()).map_err(|e| e.to_string()),
-                    None => Err("no recording in progress".to_string()),
-                };
-                let _ = reply.send(r);
-            }
-        }
-    }
-}
-
-fn finish_recording(rec: Recording) {
-    if let Err(e) = rec.finish() {
-        tracing::warn!(error = %e, "recording failed");
     }
 }
 

@@ -1,0 +1,250 @@
+//! The processing thread: frames from the receive task's queue through the [`Pipeline`] and
+//! straight out to the subscribers ([`Fanout`]); control commands between frames; the
+//! recording; counters merged into the shared [`Stats`] between bursts. While its queue is
+//! empty it parks, or polls around a steady source's next expected frame ([`ArrivalClock`]).
+
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use crossbeam_channel::{Receiver, Sender};
+
+use super::arrival::{ArrivalClock, SpinWindow, Wait};
+use super::control::Cmd;
+use super::pipeline::{Emitted, Pipeline};
+use super::record::Recording;
+use super::sender::Fanout;
+use super::stats::Stats;
+
+/// The processing thread merges its counters and histograms into the shared [`Stats`] (a
+/// lock, a histogram add and reset: tens of µs) only between bursts: when its queue is empty
+/// and this long has passed since the last merge, after 50 ms idle, or after a command.
+const MERGE_EVERY: Duration = Duration::from_millis(100);
+/// ... and at least this often under sustained load, when the queue is never empty.
+const MERGE_AT_LEAST: Duration = Duration::from_secs(1);
+/// The processing thread parks at most this long between two looks at its counters.
+const IDLE: Duration = Duration::from_millis(50);
+/// One received datagram.
+#[derive(Debug)]
+pub(crate) struct InFrame {
+    pub(crate) peer: SocketAddr,
+    pub(crate) bytes: Vec<u8>,
+    pub(crate) received: Instant,
+}
+
+/// The processing thread's ends of the channels.
+pub(crate) struct Channels {
+    /// Received frames (bounded; the receive task drops the oldest when full).
+    pub(crate) frames: Receiver<InFrame>,
+    /// Datagram buffers handed back to the receive task.
+    pub(crate) free: Sender<Vec<u8>>,
+    /// Control commands, applied between frames.
+    pub(crate) commands: Receiver<Cmd>,
+}
+
+/// The processing thread's state.
+pub(crate) struct Processing {
+    pipeline: Pipeline,
+    fanout: Fanout,
+    arrival: ArrivalClock,
+    poll_hits: u64,
+    poll_misses: u64,
+    frame_rx: Receiver<InFrame>,
+    free_tx: Sender<Vec<u8>>,
+    cmd_rx: Receiver<Cmd>,
+    stats: Arc<Mutex<Stats>>,
+    queue_dropped: Arc<AtomicU64>,
+    recording: Option<Recording>,
+    processed_us: hdrhistogram::Histogram<u64>,
+}
+
+impl Processing {
+    /// A processing thread's state; [`Processing::run`] runs it.
+    pub(crate) fn new(
+        pipeline: Pipeline,
+        fanout: Fanout,
+        poll_window: Duration,
+        channels: Channels,
+        (stats, queue_dropped): (Arc<Mutex<Stats>>, Arc<AtomicU64>),
+    ) -> Processing {
+        let mut processing = Processing {
+            pipeline,
+            fanout,
+            arrival: ArrivalClock::new(SpinWindow {
+                lead: poll_window,
+                grace: poll_window / 2,
+            }),
+            poll_hits: 0,
+            poll_misses: 0,
+            frame_rx: channels.frames,
+            free_tx: channels.free,
+            cmd_rx: channels.commands,
+            stats,
+            queue_dropped,
+            recording: None,
+            processed_us: Stats::histogram(),
+        };
+        processing.pipeline.set_wanted(processing.fanout.wanted());
+        processing
+    }
+
+    /// Runs until the receive task closes the queue, then closes the recording.
+    pub(crate) fn run(mut self) {
+        let mut last_merge = Instant::now();
+        loop {
+            let now = Instant::now();
+            // `idle`: the timeout below means nothing came for a while (not a planned wake-up
+            // before the next beat), a good moment for the counters.
+            let (timeout, idle) = match self.arrival.plan(now) {
+                Wait::PollUntil(until) => {
+                    if self.poll_until(until) {
+                        self.poll_hits += 1;
+                    } else {
+                        self.poll_misses += 1;
+                    }
+                    (IDLE, true)
+                }
+                Wait::ParkUntil(at) => ((at - now).min(IDLE), false),
+                Wait::Park => (IDLE, true),
+            };
+            crossbeam_channel::select! {
+                recv(self.frame_rx) -> msg => match msg {
+                    Ok(frame) => {
+                        self.arrival.frame_arrived(frame.received);
+                        self.process(frame);
+                        let since = last_merge.elapsed();
+                        if since >= MERGE_AT_LEAST
+                            || (since >= MERGE_EVERY && self.frame_rx.is_empty())
+                        {
+                            self.merge_stats();
+                            self.housekeeping();
+                            last_merge = Instant::now();
+                        }
+                    }
+                    Err(_) => break,
+                },
+                recv(self.cmd_rx) -> cmd => if let Ok(cmd) = cmd {
+                    self.command(cmd);
+                    // So that a `/status` right after a command sees its effect.
+                    self.merge_stats();
+                },
+                default(timeout) => if idle {
+                    self.merge_stats();
+                    self.housekeeping();
+                    last_merge = Instant::now();
+                },
+            }
+        }
+        self.merge_stats();
+        if let Some(rec) = self.recording.take() {
+            finish_recording(rec);
+        }
+    }
+
+    /// Polls the queues until something comes (`true`) or `until`. No `spin_loop` hint: a
+    /// hypervisor may take a run of PAUSE instructions as lock contention and deschedule the
+    /// CPU.
+    fn poll_until(&self, until: Instant) -> bool {
+        loop {
+            if !self.frame_rx.is_empty() || !self.cmd_rx.is_empty() {
+                return true;
+            }
+            if Instant::now() >= until {
+                return false;
+            }
+        }
+    }
+
+    fn process(&mut self, frame: InFrame) {
+        let Processing {
+            pipeline,
+            fanout,
+            recording,
+            processed_us,
+            ..
+        } = self;
+        let received = frame.received;
+        let mut clients_changed = false;
+        pipeline.handle_datagram(frame.peer, &frame.bytes, &mut |e: &Emitted<'_>| {
+            let processed = Instant::now();
+            Stats::record(
+                processed_us,
+                processed.duration_since(received).as_micros() as u64,
+            );
+            // Send before recording: the file write is not on the subscribers' path.
+            clients_changed |= fanout.send(e, processed);
+            if let Some(rec) = recording.as_mut() {
+                rec.push(e);
+            }
+        });
+        if clients_changed {
+            self.pipeline.set_wanted(self.fanout.wanted());
+        }
+        let _ = self.free_tx.try_send(frame.bytes);
+    }
+
+    /// Between frames: subscriptions whose lease ended.
+    fn housekeeping(&mut self) {
+        if self.fanout.expire(Instant::now()) {
+            self.pipeline.set_wanted(self.fanout.wanted());
+        }
+    }
+
+    fn merge_stats(&mut self) {
+        let Ok(mut s) = self.stats.lock() else { return };
+        s.counters = self.pipeline.counters.clone();
+        s.counters.dropped_queue_full = self.queue_dropped.load(Ordering::Relaxed);
+        s.streams = self.pipeline.stream_count() as u64;
+        s.send = self.fanout.counters.clone();
+        (s.poll_hits, s.poll_misses) = (self.poll_hits, self.poll_misses);
+        s.clients = self.fanout.len() as u64;
+        // Same bounds on both sides, so adding never fails.
+        let _ = s.processed_us.add(&self.processed_us);
+        self.processed_us.reset();
+        let _ = s.sent_us.add(&self.fanout.sent_us);
+        self.fanout.sent_us.reset();
+    }
+
+    fn command(&mut self, cmd: Cmd) {
+        match cmd {
+            Cmd::Edit(control, reply) => {
+                let r = self
+                    .pipeline
+                    .handle_edit(&control)
+                    .map_err(|e| e.to_string());
+                let _ = reply.send(r);
+            }
+            Cmd::Client(peer, control, reply) => {
+                let r = self.fanout.command(peer, &control);
+                self.pipeline.set_wanted(self.fanout.wanted());
+                let _ = reply.send(r);
+            }
+            Cmd::SetModel(model, reply) => {
+                self.pipeline.set_model(model);
+                let _ = reply.send(Ok(()));
+            }
+            Cmd::RecordStart(path, raw, reply) => {
+                if let Some(rec) = self.recording.take() {
+                    finish_recording(rec);
+                }
+                let r =
+                    Recording::start(&path, raw.as_deref()).map(|rec| self.recording = Some(rec));
+                let _ = reply.send(r.map_err(|e| e.to_string()));
+            }
+            Cmd::RecordStop(reply) => {
+                let r = match self.recording.take() {
+                    Some(rec) => rec.finish().map(|_| ()).map_err(|e| e.to_string()),
+                    None => Err("no recording in progress".to_string()),
+                };
+                let _ = reply.send(r);
+            }
+        }
+    }
+}
+
+fn finish_recording(rec: Recording) {
+    if let Err(e) = rec.finish() {
+        tracing::warn!(error = %e, "recording failed");
+    }
+}
