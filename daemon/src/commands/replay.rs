@@ -98,7 +98,7 @@ fn local_for(to: SocketAddr) -> SocketAddr {
 }
 
 /// Sleeps until [`SPIN`] before `deadline`, then spins; returns early on a stop request.
-pub(crate) fn wait_until(deadline: Instant, stop: &AtomicBool) {
+fn wait_until(deadline: Instant, stop: &AtomicBool) {
     loop {
         let now = Instant::now();
         if now >= deadline || stop.load(Ordering::Relaxed) {

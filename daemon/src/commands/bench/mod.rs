@@ -1,0 +1,158 @@
+//! `emoshift bench`: the daemon against a plain UDP relay on loopback, in one run.
+//!
+//! 1. Paced: N senders at 120 Hz, K receivers, through the daemon and through a minimal relay
+//!    (receive, send the same bytes to every receiver), alternating in rounds of a second.
+//!    Each frame carries its send time in the capture-time field, which the daemon keeps, so a
+//!    receiver measures the whole path. The daemon's `/status` tells its own stage latencies.
+//! 2. Max rate: one sender at 50,000 frames/s through the daemon to one receiver: loss, and
+//!    where frames went (from `/status`).
+//! 3. One processing thread: frames through [`Pipeline`] back to back (109 markers, m = 20).
+//!
+//! Bounded in time, only 127.0.0.1.
+
+mod harness;
+
+use std::net::SocketAddr;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use ica_core::model::IcaModel;
+use protocol::{encode_frame_into, FrameBuf};
+
+use crate::cli::BenchArgs;
+use crate::serve::pipeline::{Pipeline, PipelineConfig};
+use crate::serve::synthetic::{frame_into, labels_datagram, random_model};
+use harness::{through_daemon, through_relay, Run};
+
+const MARKERS: usize = 109;
+const COMPONENTS: usize = 20;
+const MAX_RATE_HZ: f64 = 50_000.0;
+/// The daemon and the relay alternate in rounds of at most this long, so that a change in
+/// the machine's load during the run falls on both alike.
+const ROUND: Duration = Duration::from_secs(1);
+
+pub(crate) fn run(args: &BenchArgs) -> Result<()> {
+    if args.performers == 0 || args.clients == 0 || !(args.seconds > 0.0 && args.seconds <= 60.0) {
+        return Err(crate::exit::UsageError(
+            "--performers and --clients must be at least 1, --seconds in (0, 60]".into(),
+        )
+        .into());
+    }
+    let model = random_model(MARKERS, COMPONENTS, 1);
+    // Senders and receivers on one thread; the daemon and the relay each on their own.
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the tokio runtime")?;
+    let rounds = (args.seconds / ROUND.as_secs_f64()).ceil().max(1.0) as u32;
+    let per_round = Duration::from_secs_f64(args.seconds) / rounds;
+    let (n, k) = (args.performers, args.clients);
+    let (daemon, relay, max) = runtime.block_on(async {
+        let w = args.poll_window_us;
+        let mut daemon = through_daemon(&model, n, k, 120.0, per_round, w).await?;
+        let mut relay = through_relay(&model, n, k, per_round).await?;
+        for _ in 1..rounds {
+            daemon.add(through_daemon(&model, n, k, 120.0, per_round, w).await?);
+            relay.add(&through_relay(&model, n, k, per_round).await?);
+        }
+        let max = through_daemon(&model, 1, 1, MAX_RATE_HZ, Duration::from_secs(1), w).await?;
+        anyhow::Ok((daemon, relay, max))
+    })?;
+    let sent = daemon.sent * k as u64;
+    crate::out!(
+        "paced: {} performers x 120 Hz, {} clients, {} s, {MARKERS} markers, m = {COMPONENTS}",
+        args.performers,
+        args.clients,
+        args.seconds
+    );
+    for (name, s) in [("daemon", &daemon.seen), ("relay", &relay)] {
+        crate::out!("  {name}: {} of ~{sent} datagrams received", s.received);
+    }
+    crate::out!(
+        "  inside the daemon: received -> processed p50 {} µs, p99 {} µs; processed -> sent p50 {} µs, p99 {} µs",
+        daemon.get("processed_p50_us"),
+        daemon.get("processed_p99_us"),
+        daemon.get("sent_p50_us"),
+        daemon.get("sent_p99_us"),
+    );
+    crate::out!(
+        "  frames caught by polling around the beat: {} of {} windows",
+        daemon.get("poll_hits"),
+        daemon.get("poll_hits") + daemon.get("poll_misses"),
+    );
+    for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999), ("max", 1.0)] {
+        let d = daemon.seen.latency_us.value_at_quantile(q);
+        let r = relay.latency_us.value_at_quantile(q);
+        crate::out!(
+            "{label} added latency: {d} µs (relay {r} µs, ratio {:.2}x)",
+            d as f64 / r.max(1) as f64
+        );
+    }
+    print_max_rate(&max)?;
+    let (per_frame_us, fps) = processing_rate(&model)?;
+    crate::out!(
+        "processing: {per_frame_us:.2} µs/frame median over batches, {fps:.0} frames/s on one thread"
+    );
+    Ok(())
+}
+
+/// Where the frames of the max-rate run went, stage by stage.
+fn print_max_rate(max: &Run) -> Result<()> {
+    let received = max.seen.received as i64;
+    let frames_in = max.get("frames_in");
+    crate::out!(
+        "max rate: {} frames sent at {MAX_RATE_HZ} /s, {received} received, loss {:.3}%",
+        max.sent,
+        100.0 * (1.0 - received as f64 / max.sent.max(1) as f64)
+    );
+    crate::out!(
+        "  lost at the daemon's socket {}, dropped in the daemon {} (queue full {}, stale {}), \
+         not sent {}, lost at the receiver's socket {}",
+        max.sent as i64 - frames_in,
+        frames_in - max.get("frames_out"),
+        max.get("frames_dropped"),
+        max.get("dropped_stale"),
+        max.get("dropped_send_buffer") + max.get("send_errors"),
+        max.get("datagrams_sent") - received,
+    );
+    Ok(())
+}
+
+/// Frames through one [`Pipeline`] back to back: median µs/frame over batches, frames/s.
+fn processing_rate(model: &IcaModel) -> Result<(f64, f64)> {
+    let model = Arc::new(model.clone());
+    let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let peer: SocketAddr = "127.0.0.1:9".parse()?;
+    let mut d = labels_datagram(&model)?;
+    pipeline.handle_datagram(peer, &d, &mut |_| {});
+    let mut xyz = vec![0.0f32; MARKERS * 3];
+    frame_into(&model, 3, &mut xyz);
+    let mut buf = FrameBuf::with_max_markers(MARKERS);
+    buf.set_frame(0, 0, &xyz)?;
+    encode_frame_into(&buf, &mut d)?;
+    let (batch, batches) = (2_000usize, 25usize);
+    let mut per_frame = Vec::with_capacity(batches);
+    let mut n: i32 = 0;
+    let start = Instant::now();
+    for _ in 0..batches {
+        let t = Instant::now();
+        for _ in 0..batch {
+            n += 1;
+            // frame number: after "/mocap/frame\0..." (16) and ",ihbb\0\0\0" (8)
+            d[24..28].copy_from_slice(&n.to_be_bytes());
+            pipeline.handle_datagram(peer, &d, &mut |_| {});
+        }
+        per_frame.push(t.elapsed().as_secs_f64() * 1e6 / batch as f64);
+    }
+    let total = start.elapsed().as_secs_f64();
+    per_frame.sort_by(f64::total_cmp);
+    if pipeline.counters.frames_out != (batch * batches) as u64 {
+        anyhow::bail!(
+            "the pipeline dropped frames: {} of {} out",
+            pipeline.counters.frames_out,
+            batch * batches
+        );
+    }
+    Ok((per_frame[batches / 2], (batch * batches) as f64 / total))
+}
