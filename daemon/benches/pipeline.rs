@@ -1,5 +1,8 @@
 //! The whole live frame path (decode → map → project → edit → resynthesise → encode) at 109
 //! markers and m = 20, through `Pipeline::handle_datagram`; budget 2 µs a frame (issue 7).
+//! Twice: the bare synthetic model (what `emoshift bench` measures), and the same model with
+//! both glitch checks on (a speed limit and per-marker bounds, as a trained model has), set
+//! loose enough that every sample passes, so the checks' full per-marker work is measured.
 
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -7,10 +10,11 @@ use std::sync::Arc;
 use criterion::{criterion_group, criterion_main, Criterion};
 use daemon::serve::pipeline::{Pipeline, PipelineConfig};
 use daemon::serve::synthetic::{frame_into, labels_datagram, random_model};
+use ica_core::model::{CaptureSettings, IcaModel, MarkerBounds};
 use protocol::{encode_frame_into, FrameBuf};
 
-fn whole_frame_path(c: &mut Criterion) {
-    let model = Arc::new(random_model(109, 20, 1));
+fn bench_model(c: &mut Criterion, name: &str, model: IcaModel) {
+    let model = Arc::new(model);
     let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
     let peer: SocketAddr = "127.0.0.1:9".parse().expect("literal address");
     let labels = labels_datagram(&model).expect("valid labels");
@@ -27,7 +31,7 @@ fn whole_frame_path(c: &mut Criterion) {
         })
         .collect();
     let mut n: i32 = 0;
-    c.bench_function("pipeline 109 markers m=20 compact", |b| {
+    c.bench_function(name, |b| {
         b.iter(|| {
             let d = &mut datagrams[n as usize % 120];
             // Frame numbers must increase or the stream drops the frame as stale.
@@ -38,6 +42,28 @@ fn whole_frame_path(c: &mut Criterion) {
             out
         })
     });
+    let glitches = pipeline.counters.glitches;
+    assert_eq!(glitches, 0, "{name}: the loose checks rejected {glitches} samples");
+}
+
+fn whole_frame_path(c: &mut Criterion) {
+    bench_model(c, "pipeline 109 markers m=20 compact", random_model(109, 20, 1));
+    let mut checked = random_model(109, 20, 1);
+    let centre = checked
+        .mean()
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    let capture = CaptureSettings {
+        max_speed_mm_s: Some(1e7),
+        bounds: Some(MarkerBounds {
+            centre,
+            radius_mm: vec![1e4; 109],
+        }),
+        ..CaptureSettings::default()
+    };
+    checked.set_capture(capture).expect("bounds for every marker");
+    bench_model(c, "pipeline 109 markers m=20 compact, glitch checks", checked);
 }
 
 criterion_group!(benches, whole_frame_path);
