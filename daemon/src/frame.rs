@@ -50,6 +50,8 @@ pub struct FramePrep {
     rejected_run: Vec<u32>,
     /// Frames a marker was absent (not rejected) since its last accepted sample.
     unseen_run: Vec<u32>,
+    /// Every marker's last sample was accepted: all known, every run 0.
+    steady: bool,
     missing: Vec<bool>,
     head: Vec<f32>,
     /// Per-marker centre (x y z) and squared radius of the plausible region, head coordinates.
@@ -83,6 +85,7 @@ impl FramePrep {
             last_known: vec![false; markers],
             rejected_run: vec![0; markers],
             unseen_run: vec![0; markers],
+            steady: false,
             missing: vec![false; markers],
             head: vec![0.0; markers * 3],
             bounds: capture.bounds.as_ref().map(|b| {
@@ -103,6 +106,7 @@ impl FramePrep {
         self.last_known.fill(false);
         self.rejected_run.fill(0);
         self.unseen_run.fill(0);
+        self.steady = false;
         if let Some(s) = &mut self.stabiliser {
             s.reset();
         }
@@ -142,15 +146,14 @@ impl FramePrep {
                 info.pose_held = est.held;
                 true
             }
-            None => {
-                // only the glitch checks read `head`: without them the copy is wasted
-                if self.bounds.is_some() || self.max_step_mm.is_some() {
-                    self.head.copy_from_slice(xyz);
-                }
-                false
-            }
+            None => false,
         };
-        info.glitches = self.check_bounds() + self.check_speed();
+        // The checks read the frame in place when it is not stabilised (no copy into `head`);
+        // `head` is moved out meanwhile (no allocation) so they can borrow `self` mutably.
+        let head = std::mem::take(&mut self.head);
+        let pos = if stabilised { &head[..] } else { xyz };
+        info.glitches = self.check_bounds(pos) + self.check_speed(pos);
+        self.head = head;
         Ok(PreparedFrame {
             xyz: if stabilised { &self.head } else { xyz },
             missing: &self.missing,
@@ -159,15 +162,14 @@ impl FramePrep {
     }
 
     /// Marks samples outside their marker's plausible ball (head coordinates) as missing.
-    fn check_bounds(&mut self) -> usize {
+    fn check_bounds(&mut self, pos: &[f32]) -> usize {
         let Some((centre, r2)) = &self.bounds else {
             return 0;
         };
         // Zipped chunks, no indexing: no bounds checks, and the branch-free test lets the
         // accepted-sample path (nearly every sample) run without a mispredict.
         let mut glitches = 0;
-        for (((p, c), &r2), gone) in self
-            .head
+        for (((p, c), &r2), gone) in pos
             .chunks_exact(3)
             .zip(centre.chunks_exact(3))
             .zip(r2)
@@ -183,16 +185,19 @@ impl FramePrep {
 
     /// Marks samples that moved faster than the speed limit since their marker's last accepted
     /// sample (head coordinates, so head motion does not count) as missing.
-    fn check_speed(&mut self) -> usize {
+    fn check_speed(&mut self, pos: &[f32]) -> usize {
         // Without a limit nothing reads the history below (`last`, the runs): skip the pass.
         let Some(step) = self.max_step_mm else {
             return 0;
         };
+        if self.steady_frame_within(pos, step) {
+            self.last.copy_from_slice(pos);
+            return 0;
+        }
         let release = self.release_frames;
         let mut glitches = 0;
         // Every per-marker array zipped: no bounds checks in the loop (it was indexed by m).
-        let markers = self
-            .head
+        let markers = pos
             .chunks_exact(3)
             .zip(self.last.chunks_exact_mut(3))
             .zip(self.missing.iter_mut())
@@ -222,8 +227,38 @@ impl FramePrep {
             *rejected = 0;
             *unseen = 0;
         }
+        self.steady = glitches == 0 && !any(&self.missing);
         glitches
     }
+
+    /// The whole frame passes the speed check, decided in two vectorised passes: after a
+    /// frame whose samples were all accepted (so every allowance is one `step`), with no
+    /// sample missing now, and no coordinate moved more than `0.57 step` (then no marker moved
+    /// more than `√3 · 0.57 < 0.99` steps, clear of the exact test's rounding). Otherwise
+    /// the per-marker loop decides, so the outcome is the same either way.
+    fn steady_frame_within(&self, pos: &[f32], step: f32) -> bool {
+        if !self.steady || any(&self.missing) {
+            return false;
+        }
+        let limit = 0.57 * step;
+        let mut moved = [0.0_f32; 8];
+        let (p, q) = (pos.chunks_exact(8), self.last.chunks_exact(8));
+        let tail = p.remainder().iter().zip(q.remainder());
+        let tail_ok = tail.fold(true, |ok, (a, b)| ok & ((a - b).abs() <= limit));
+        for (p, q) in p.zip(q) {
+            for i in 0..8 {
+                let d = (p[i] - q[i]).abs();
+                moved[i] = if d > moved[i] { d } else { moved[i] };
+            }
+        }
+        // No NaN reaches here: with no sample missing every coordinate is finite.
+        tail_ok && moved.iter().all(|&d| d <= limit)
+    }
+}
+
+/// Any flag set, without an early exit (so it vectorises).
+fn any(flags: &[bool]) -> bool {
+    flags.iter().fold(false, |a, &b| a | b)
 }
 
 fn sq(v: f32) -> f32 {
@@ -373,6 +408,28 @@ mod tests {
         assert_eq!(
             (out.missing, out.info.glitches),
             (&[false, true, false][..], 1)
+        );
+
+        // Steady frames take the two-pass path; it must decide exactly as the per-marker
+        // loop: 6 mm on each axis is 10.4 mm in space (rejected), 5.7 mm is 9.9 mm (kept),
+        // 9.9 mm along one axis is kept by the loop after the fast test declines.
+        let mut prep = FramePrep::new(3, 100.0, &limited);
+        let mut xyz = [0.0_f32; 9];
+        for _ in 0..3 {
+            let out = prep.prepare(&xyz, &[false; 3]).expect("sizes match");
+            assert_eq!(out.info.glitches, 0);
+        }
+        xyz[0..3].fill(5.7);
+        xyz[3] = 9.9;
+        let out = prep.prepare(&xyz, &[false; 3]).expect("sizes match");
+        assert_eq!(out.info.glitches, 0);
+        prep.prepare(&xyz, &[false; 3]).expect("sizes match");
+        xyz[0..3].iter_mut().for_each(|v| *v += 5.0);
+        xyz[6..9].fill(6.0);
+        let out = prep.prepare(&xyz, &[false; 3]).expect("sizes match");
+        assert_eq!(
+            (out.missing, out.info.glitches),
+            (&[false, false, true][..], 1)
         );
 
         // Balls of radius 2 mm around the origin; a missing marker is not counted twice.
