@@ -149,6 +149,11 @@ impl Pipeline {
         self.streams.len()
     }
 
+    /// Each stream's counters.
+    pub fn stream_status(&self) -> Vec<super::streams::StreamStatus> {
+        self.streams.status(&self.performers)
+    }
+
     /// Swaps in a new default model at a frame boundary: streams on the default model are
     /// rebuilt on it, keeping their edit settings; no frame is dropped.
     pub fn set_model(&mut self, model: Arc<IcaModel>) {

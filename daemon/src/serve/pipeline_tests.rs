@@ -167,3 +167,27 @@ fn a_model_swap_keeps_the_stream_order_and_settings() {
         })
     );
 }
+
+#[test]
+fn frame_order_is_counted_per_stream() {
+    let model = Arc::new(random_model(MARKERS, 4, 5));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let mut xyz = vec![0.0; MARKERS * 3];
+    frame_into(&model, 0, &mut xyz);
+    let (a, b): (SocketAddr, SocketAddr) = (
+        "127.0.0.1:7001".parse().expect("literal address"),
+        "127.0.0.1:7002".parse().expect("literal address"),
+    );
+    for (peer, numbers) in [(a, vec![0, 1, 2]), (b, vec![0, 2, 1, 2])] {
+        p.handle_datagram(peer, &labels_datagram(&model, false), &mut |_| {});
+        for n in numbers {
+            p.handle_datagram(peer, &frame_datagram(&xyz, n), &mut |_| {});
+        }
+    }
+    let status = p.stream_status();
+    let counts: Vec<_> = status
+        .iter()
+        .map(|s| (s.key.source, s.frames, s.duplicates, s.stale))
+        .collect();
+    assert_eq!(counts, vec![(a, 3, 0, 0), (b, 2, 1, 1)]);
+}

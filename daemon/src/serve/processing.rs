@@ -196,6 +196,7 @@ impl Processing {
         s.counters = self.pipeline.counters.clone();
         s.counters.dropped_queue_full = self.queue_dropped.load(Ordering::Relaxed);
         s.streams = self.pipeline.stream_count() as u64;
+        s.per_stream = self.pipeline.stream_status();
         s.send = self.fanout.counters.clone();
         (s.poll_hits, s.poll_misses) = (self.poll_hits, self.poll_misses);
         s.clients = self.fanout.len() as u64;

@@ -4,6 +4,8 @@
 use hdrhistogram::Histogram;
 use protocol::DecodeErrorKind;
 
+use super::streams::StreamStatus;
+
 /// Counters of the processing path, owned by the pipeline (plain integers, no locking).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Counters {
@@ -81,6 +83,8 @@ pub struct Stats {
     pub poll_hits: u64,
     /// Polling windows that ended without a frame.
     pub poll_misses: u64,
+    /// Each stream's counters.
+    pub per_stream: Vec<StreamStatus>,
 }
 
 impl Default for Stats {
@@ -106,6 +110,7 @@ impl Stats {
             streams: 0,
             poll_hits: 0,
             poll_misses: 0,
+            per_stream: Vec::new(),
         }
     }
 
@@ -148,6 +153,16 @@ impl Stats {
         for kind in DecodeErrorKind::ALL {
             out.push((format!("bad_{}", kind.as_str()), i(c.bad[kind.index()])));
         }
+        for st in &self.per_stream {
+            let name = format!("stream/{}/{}", st.key.source, st.key.layout_id);
+            for (what, v) in [
+                ("frames", st.frames),
+                ("dropped_duplicate", st.duplicates),
+                ("dropped_stale", st.stale),
+            ] {
+                out.push((format!("{name}/{what}"), i(v)));
+            }
+        }
         for (name, h) in [("processed", &self.processed_us), ("sent", &self.sent_us)] {
             for (q, label) in [(0.5, "p50"), (0.99, "p99"), (0.999, "p999")] {
                 out.push((format!("{name}_{label}_us"), i(h.value_at_quantile(q))));
@@ -172,6 +187,17 @@ impl Stats {
             sent_p99_us = self.sent_us.value_at_quantile(0.99),
             "status"
         );
+        for st in &self.per_stream {
+            tracing::info!(
+                source = %st.key.source,
+                layout = st.key.layout_id,
+                performer = st.performer.as_deref().unwrap_or("-"),
+                frames = st.frames,
+                dropped_duplicate = st.duplicates,
+                dropped_stale = st.stale,
+                "stream"
+            );
+        }
     }
 }
 
@@ -185,6 +211,16 @@ mod tests {
         s.counters.frames_in = 3;
         s.counters.bad_packet(DecodeErrorKind::Truncated);
         Stats::record(&mut s.processed_us, 40);
+        s.per_stream.push(StreamStatus {
+            key: super::super::streams::StreamKey {
+                source: "127.0.0.1:5000".parse().expect("literal address"),
+                layout_id: 2,
+            },
+            performer: None,
+            frames: 7,
+            duplicates: 1,
+            stale: 3,
+        });
         let pairs = s.pairs();
         let get = |n: &str| pairs.iter().find(|(k, _)| k == n).map(|(_, v)| *v);
         assert_eq!(get("frames_in"), Some(3));
@@ -194,5 +230,7 @@ mod tests {
             Some(1)
         );
         assert_eq!(get("processed_p50_us"), Some(40));
+        assert_eq!(get("stream/127.0.0.1:5000/2/frames"), Some(7));
+        assert_eq!(get("stream/127.0.0.1:5000/2/dropped_stale"), Some(3));
     }
 }

@@ -27,6 +27,22 @@ pub struct StreamKey {
     pub layout_id: i32,
 }
 
+/// One stream's counters (frame order is per stream: a late frame of one performer says
+/// nothing about another).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StreamStatus {
+    /// The stream.
+    pub key: StreamKey,
+    /// The performer owning it, if named in the config.
+    pub performer: Option<String>,
+    /// Frames taken in order.
+    pub frames: u64,
+    /// Duplicate frame numbers dropped.
+    pub duplicates: u64,
+    /// Out-of-order (older) frames dropped.
+    pub stale: u64,
+}
+
 /// A named performer: which streams it owns, its model and default emotion.
 #[derive(Debug, Clone)]
 pub struct Performer {
@@ -95,6 +111,8 @@ pub struct Stream {
     /// profile), from the model's roles.
     pub vmc: Vec<(String, usize)>,
     last_frame: Option<i32>,
+    /// Frames taken in order (processed).
+    pub frames: u64,
     /// Duplicate frame numbers dropped.
     pub duplicates: u64,
     /// Out-of-order (older) frames dropped.
@@ -153,6 +171,7 @@ impl Stream {
             out: vec![0.0; n * 3],
             vmc: vmc_names(&model),
             last_frame: None,
+            frames: 0,
             duplicates: 0,
             stale: 0,
             model,
@@ -164,6 +183,7 @@ impl Stream {
     /// next frame is neither dropped nor taken for a restart.
     pub fn take_last_frame_from(&mut self, old: &Stream) {
         self.last_frame = old.last_frame;
+        self.frames = old.frames;
         self.duplicates = old.duplicates;
         self.stale = old.stale;
     }
@@ -173,6 +193,7 @@ impl Stream {
     pub fn check_order(&mut self, frame_number: i32) -> Order {
         let Some(last) = self.last_frame else {
             self.last_frame = Some(frame_number);
+            self.frames += 1;
             return Order::Next { frames: 1 };
         };
         let delta = i64::from(frame_number) - i64::from(last);
@@ -191,8 +212,12 @@ impl Stream {
                 self.processor.reset();
                 self.edit.reset_lowpass();
                 self.last_frame = Some(frame_number);
+                self.frames += 1;
             }
-            Order::Next { .. } => self.last_frame = Some(frame_number),
+            Order::Next { .. } => {
+                self.last_frame = Some(frame_number);
+                self.frames += 1;
+            }
         }
         order
     }
@@ -263,6 +288,23 @@ impl Streams {
     /// No stream yet.
     pub fn is_empty(&self) -> bool {
         self.map.is_empty()
+    }
+
+    /// Each stream's counters, for `/status` and the log, in a stable order.
+    pub fn status(&self, performers: &[Performer]) -> Vec<StreamStatus> {
+        let mut out: Vec<StreamStatus> = self
+            .map
+            .iter()
+            .map(|(key, s)| StreamStatus {
+                key: *key,
+                performer: s.performer.map(|i| performers[i].name.clone()),
+                frames: s.frames,
+                duplicates: s.duplicates,
+                stale: s.stale,
+            })
+            .collect();
+        out.sort_by_key(|s| (s.key.source, s.key.layout_id));
+        out
     }
 
     /// Duplicates and stale frames over all streams.
