@@ -12,29 +12,24 @@ use std::sync::Arc;
 
 use ica_core::model::IcaModel;
 use protocol::{
-    decode_frame_into, decode_labels, encode_compact_into, encode_components_into, messages,
-    Address, Control, FlatSplit, FrameBuf, LayoutBook, LayoutChange, Limits, Profile,
-    ETHERNET_PAYLOAD,
+    decode_frame_into, decode_labels, messages, Address, Control, FlatSplit, FrameBuf, LayoutBook,
+    LayoutChange, Limits, Profile, ETHERNET_PAYLOAD,
 };
 
-use super::edit_state::EditRefused;
-use super::stats::Counters;
-use super::streams::{Order, Performer, Stream, StreamKey, Streams};
+use crate::serve::edit_state::EditRefused;
+use crate::serve::stats::Counters;
+use crate::serve::streams::{Order, Performer, Stream, StreamKey, Streams};
+
+mod encode;
+mod setup;
+
+use encode::encode;
+pub use encode::{profile_bit, ProfileMask};
+pub use setup::apply_edit;
+use setup::{new_stream, source_labels};
 
 /// Sources tracked for labels, and streams, at most (bounds memory against spoofed senders).
 pub const MAX_SOURCES: usize = 64;
-
-/// Profiles to encode, as a bit set (`1 << profile index` in [`Profile::ALL`]).
-pub type ProfileMask = u8;
-
-/// The bit of one profile.
-pub fn profile_bit(p: Profile) -> ProfileMask {
-    match p {
-        Profile::Compact => 1,
-        Profile::FlatSplit => 2,
-        Profile::Components => 4,
-    }
-}
 
 /// One processed frame, borrowed from the pipeline's buffers.
 #[derive(Debug)]
@@ -75,7 +70,7 @@ pub struct PipelineConfig {
 impl Default for PipelineConfig {
     fn default() -> Self {
         PipelineConfig {
-            lowpass_s: super::edit_state::DEFAULT_LOWPASS_S,
+            lowpass_s: crate::serve::edit_state::DEFAULT_LOWPASS_S,
             max_markers: 1_000,
         }
     }
@@ -90,7 +85,7 @@ pub struct Pipeline {
     layouts: LayoutBook<SocketAddr>,
     streams: Streams,
     /// Settings of the default model's streams, copied into new streams.
-    template: super::edit_state::EditState,
+    template: crate::serve::edit_state::EditState,
     limits: Limits,
     frame_in: FrameBuf,
     frame_out: FrameBuf,
@@ -108,7 +103,7 @@ pub struct Pipeline {
 impl Pipeline {
     /// A pipeline over `model`, with optional named performers.
     pub fn new(model: Arc<IcaModel>, performers: Vec<Performer>, config: PipelineConfig) -> Self {
-        let template = super::edit_state::EditState::new(
+        let template = crate::serve::edit_state::EditState::new(
             model.components(),
             model.emotion().component,
             config.lowpass_s,
@@ -150,14 +145,14 @@ impl Pipeline {
     }
 
     /// Each stream's counters.
-    pub fn stream_status(&self) -> Vec<super::streams::StreamStatus> {
+    pub fn stream_status(&self) -> Vec<crate::serve::streams::StreamStatus> {
         self.streams.status(&self.performers)
     }
 
     /// Swaps in a new default model at a frame boundary: streams on the default model are
     /// rebuilt on it, keeping their edit settings; no frame is dropped.
     pub fn set_model(&mut self, model: Arc<IcaModel>) {
-        let mut template = super::edit_state::EditState::new(
+        let mut template = crate::serve::edit_state::EditState::new(
             model.components(),
             model.emotion().component,
             self.config.lowpass_s,
@@ -353,126 +348,6 @@ impl Pipeline {
     }
 }
 
-/// A new stream for `key` on its performer's model (or the default one, with the template's
-/// edit settings); `None` when its labels share none with the model.
-fn new_stream(
-    key: &StreamKey,
-    source_labels: &[String],
-    performers: &[Performer],
-    default_model: &Arc<IcaModel>,
-    template: &super::edit_state::EditState,
-    lowpass_s: f32,
-) -> Option<Stream> {
-    let performer = performers.iter().position(|p| p.owns(key));
-    let p = performer.map(|i| &performers[i]);
-    let model = p
-        .and_then(|p| p.model.clone())
-        .unwrap_or_else(|| Arc::clone(default_model));
-    let mut stream = Stream::new(Arc::clone(&model), performer, source_labels, lowpass_s).ok()?;
-    if Arc::ptr_eq(&model, default_model) {
-        stream.edit.copy_settings(template);
-    }
-    if let Some(p) = p {
-        defaults_of(p, &mut stream);
-    }
-    Some(stream)
-}
-
-/// A performer's default emotion, set at once (no ramp) on a new stream.
-fn defaults_of(p: &Performer, stream: &mut Stream) {
-    stream.edit.set_ramp(0.0);
-    if let Some(target) = &p.target {
-        let _ = apply_edit(
-            &mut stream.edit,
-            &stream.model,
-            &Control::Target(target.clone()),
-        );
-    }
-    if let Some(amount) = p.amount {
-        let _ = stream.edit.set_amount(amount);
-    }
-    stream.edit.set_ramp(super::edit_state::DEFAULT_RAMP_S);
-}
-
-/// The stream's source labels, rebuilt from its map for a model swap (unmapped source markers
-/// get placeholder names that match nothing).
-fn source_labels(map: &crate::layout::LabelMap, model_labels: &[String]) -> Vec<String> {
-    let n = map
-        .model_to_take
-        .iter()
-        .flatten()
-        .chain(map.extra.iter())
-        .max()
-        .map_or(0, |m| m + 1);
-    let mut labels: Vec<String> = (0..n).map(|i| format!("\u{0}unmapped{i}")).collect();
-    for (i, t) in map.model_to_take.iter().enumerate() {
-        if let Some(t) = t {
-            labels[*t] = model_labels[i].clone();
-        }
-    }
-    labels
-}
-
-/// Applies one edit control to one stream's state, validated against its model.
-pub fn apply_edit(
-    edit: &mut super::edit_state::EditState,
-    model: &IcaModel,
-    control: &Control,
-) -> Result<(), EditRefused> {
-    match control {
-        Control::Target(name) => {
-            let level = model.emotion().levels.get(name).copied();
-            match (model.emotion().component, level) {
-                (None, _) => Err(EditRefused::NoEmotion),
-                (Some(_), None) => Err(EditRefused::UnknownEmotion { name: name.clone() }),
-                (Some(_), Some(level)) => edit.set_target(name, level as f32),
-            }
-        }
-        Control::Amount(a) => edit.set_amount(*a),
-        Control::Ramp(r) => {
-            edit.set_ramp(*r);
-            Ok(())
-        }
-        Control::Alpha { component, value } => edit.set_alpha(*component, *value),
-        Control::Gain { component, gain } => edit.set_gain(*component, *gain),
-        Control::Bypass(b) => {
-            edit.set_bypass(*b);
-            Ok(())
-        }
-        _ => Ok(()),
-    }
-}
-
-/// Encodes the wanted profiles of one frame into the pipeline's buffers.
-fn encode(
-    wanted: ProfileMask,
-    frame: &FrameBuf,
-    edit: &super::edit_state::EditState,
-    (u, vmc): (&[f32], &[(String, usize)]),
-    split: &FlatSplit,
-    [compact, components, part, parts]: [&mut Vec<u8>; 4],
-    part_ends: &mut Vec<usize>,
-) -> Result<(), protocol::EncodeError> {
-    compact.clear();
-    components.clear();
-    parts.clear();
-    part_ends.clear();
-    if wanted & profile_bit(Profile::Compact) != 0 {
-        encode_compact_into(frame, edit.target(), edit.amount(), compact)?;
-    }
-    if wanted & profile_bit(Profile::Components) != 0 {
-        encode_components_into(u, vmc, components)?;
-    }
-    if wanted & profile_bit(Profile::FlatSplit) != 0 {
-        for i in 0..split.part_count(frame.marker_count()) {
-            split.encode_part_into(frame, i, part);
-            parts.extend_from_slice(part);
-            part_ends.push(parts.len());
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
-#[path = "pipeline_tests.rs"]
+#[path = "tests.rs"]
 pub(crate) mod tests;

@@ -1,9 +1,6 @@
 //! Marker frames: the allocation-free borrowed decoder and the encoder of `/mocap/frame`.
 
-use crate::address::FRAME;
-use crate::error::{DecodeError, EncodeError};
-use crate::scan::read_head;
-use crate::wire::{self, Reader};
+use crate::error::DecodeError;
 
 /// Upper bound on the markers one datagram of at most 65,507 bytes can carry (blob form:
 /// 12 bytes a marker plus a bit of mask); the default capacity of [`FrameBuf`].
@@ -217,132 +214,12 @@ impl FrameBuf {
     }
 }
 
-/// Decodes one `/mocap/frame` message (either form) into `buf`, without allocating.
-///
-/// `msg` is one message: a bare datagram or a [`crate::Message::bytes`] from [`crate::messages`]
-/// (frames inside bundles). The parse is complete and strict on its own; no pre-scan is needed.
-/// On error the buffer's contents are unspecified (its capacity is kept).
-///
-/// # Errors
-/// [`DecodeError::UnknownAddress`] for another address; [`DecodeError::WrongTypeTags`] for
-/// tags other than `,ihbb` or `,ih` + `f`*; [`DecodeError::WrongCount`] for positions not a
-/// multiple of 12 bytes (3 floats), a mask of the wrong length, or mask bits set past the last
-/// marker; [`DecodeError::NonFinite`] for NaN/Inf in a present marker (blob form) or Inf (flat
-/// form); [`DecodeError::PartlyMissing`]; [`DecodeError::TooManyMarkers`]; truncation and
-/// trailing bytes.
-pub fn decode_frame_into(msg: &[u8], buf: &mut FrameBuf) -> Result<FrameHeader, DecodeError> {
-    let (address, tags, mut r) = read_head(msg)?;
-    if address != FRAME {
-        return Err(DecodeError::UnknownAddress);
-    }
-    match tags {
-        b"ihbb" => decode_blob_form(&mut r, buf)?,
-        [b'i', b'h', floats @ ..] if floats.iter().all(|&t| t == b'f') => {
-            decode_flat_form(&mut r, floats.len(), buf)?
-        }
-        _ => return Err(DecodeError::WrongTypeTags),
-    }
-    if r.remaining() != 0 {
-        return Err(DecodeError::TrailingBytes {
-            offset: r.pos(),
-            extra: r.remaining(),
-        });
-    }
-    Ok(buf.header)
-}
+mod decode;
+mod encode;
 
-fn decode_blob_form(r: &mut Reader<'_>, buf: &mut FrameBuf) -> Result<(), DecodeError> {
-    let frame_number = r.i32()?;
-    let capture_time_us = r.i64()?;
-    let mask = r.blob()?;
-    let coords = r.blob()?;
-    if coords.len() % 12 != 0 {
-        return Err(DecodeError::WrongCount {
-            expected: coords.len() / 12 * 12,
-            got: coords.len(),
-        });
-    }
-    let n = coords.len() / 12;
-    if mask.len() != n.div_ceil(8) {
-        return Err(DecodeError::WrongCount {
-            expected: n.div_ceil(8),
-            got: mask.len(),
-        });
-    }
-    // bits past the last marker must be clear, or a sender disagrees with us on the count
-    if n % 8 != 0 && mask.last().is_some_and(|&b| b >> (n % 8) != 0) {
-        return Err(DecodeError::WrongCount {
-            expected: n,
-            got: mask.len() * 8,
-        });
-    }
-    buf.reset_empty(n, FrameForm::Blob)?;
-    buf.set_header(frame_number, capture_time_us);
-    buf.missing.extend_from_slice(mask);
-    // convert every coordinate in one tight loop (it vectorises), then fix up and validate
-    be_f32s_into(coords, &mut buf.positions);
-    let all_present = mask.iter().all(|&b| b == 0);
-    if all_present && all_finite(&buf.positions) {
-        return Ok(());
-    }
-    let mut missing = 0;
-    for (m, xyz) in buf.positions.chunks_exact_mut(3).enumerate() {
-        if mask[m / 8] >> (m % 8) & 1 == 1 {
-            xyz.fill(f32::NAN);
-            missing += 1;
-        } else if !xyz.iter().all(|v| v.is_finite()) {
-            return Err(DecodeError::NonFinite { marker: m });
-        }
-    }
-    buf.header.missing_count = missing;
-    Ok(())
-}
-
-fn decode_flat_form(
-    r: &mut Reader<'_>,
-    floats: usize,
-    buf: &mut FrameBuf,
-) -> Result<(), DecodeError> {
-    if floats % 3 != 0 {
-        return Err(DecodeError::WrongCount {
-            expected: floats / 3 * 3,
-            got: floats,
-        });
-    }
-    let frame_number = r.i32()?;
-    let capture_time_us = r.i64()?;
-    let coords = r.take(floats * 4)?;
-    let n = floats / 3;
-    buf.reset_empty(n, FrameForm::Flat)?;
-    buf.set_header(frame_number, capture_time_us);
-    buf.missing.resize(n.div_ceil(8), 0);
-    be_f32s_into(coords, &mut buf.positions);
-    if all_finite(&buf.positions) {
-        return Ok(());
-    }
-    for m in 0..n {
-        let xyz = &buf.positions[3 * m..3 * m + 3];
-        match xyz.iter().filter(|v| v.is_nan()).count() {
-            0 if xyz.iter().all(|v| v.is_finite()) => {}
-            0 => return Err(DecodeError::NonFinite { marker: m }),
-            3 => {
-                buf.missing[m / 8] |= 1 << (m % 8);
-                buf.header.missing_count += 1;
-            }
-            _ => return Err(DecodeError::PartlyMissing { marker: m }),
-        }
-    }
-    Ok(())
-}
-
-/// Appends big-endian f32s (`bytes.len()` a multiple of 4) to `out`, within its capacity.
-fn be_f32s_into(bytes: &[u8], out: &mut Vec<f32>) {
-    let at = out.len();
-    out.resize(at + bytes.len() / 4, 0.0);
-    for (d, c) in out[at..].iter_mut().zip(bytes.chunks_exact(4)) {
-        *d = f32::from_be_bytes([c[0], c[1], c[2], c[3]]);
-    }
-}
+pub use decode::decode_frame_into;
+pub(crate) use encode::append_frame;
+pub use encode::{encode_frame_flat_into, encode_frame_into, frame_message_len};
 
 /// Whether every value is finite. No early exit, and integer arithmetic on the exponent bits,
 /// so the loop vectorises on baseline SSE2; `iter().all(is_finite)` stops at
@@ -361,93 +238,6 @@ pub(crate) fn all_finite(values: &[f32]) -> bool {
         }
     }
     tail && bits.iter().fold(0, |a, b| a | b) >> 31 == 0
-}
-
-/// Bytes of a `,ihbb` frame message with `markers` markers (1,368 for 109).
-pub const fn frame_message_len(markers: usize) -> usize {
-    16 + 8 + 4 + 8 + 4 + wire::pad4(markers.div_ceil(8)) + 4 + 12 * markers
-}
-
-/// Encodes `frame` as `/mocap/frame ,ihbb` into `out` (cleared first, capacity reused).
-/// Missing markers are written as NaN. Returns the encoded length.
-///
-/// # Errors
-/// [`EncodeError::NonFinite`] if a present marker holds NaN or Inf.
-pub fn encode_frame_into(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<usize, EncodeError> {
-    out.clear();
-    append_frame(frame, out)?;
-    Ok(out.len())
-}
-
-/// Appends the `,ihbb` message (used alone and inside the compact bundle).
-pub(crate) fn append_frame(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<(), EncodeError> {
-    let h = frame.header;
-    let start = out.len();
-    wire::put_str_unchecked(out, FRAME);
-    wire::put_str_unchecked(out, ",ihbb");
-    wire::put_i32(out, h.frame_number);
-    wire::put_i64(out, h.capture_time_us);
-    wire::put_blob_len(out, frame.missing.len());
-    out.extend_from_slice(&frame.missing);
-    wire::pad_to4(out, start);
-    wire::put_blob_len(out, frame.positions.len() * 4);
-    let coords_at = out.len();
-    out.resize(coords_at + frame.positions.len() * 4, 0);
-    // a zip over pre-sized slices: no capacity checks in the loop, so it vectorises
-    for (c, v) in out[coords_at..].chunks_exact_mut(4).zip(&frame.positions) {
-        c.copy_from_slice(&v.to_be_bytes());
-    }
-    // missing markers go out as NaN whatever an edit wrote into them
-    if frame.header.missing_count > 0 {
-        for (k, &byte) in frame.missing.iter().enumerate().filter(|(_, &b)| b != 0) {
-            for bit in (0..8).filter(|bit| byte >> bit & 1 == 1) {
-                let at = coords_at + 12 * (8 * k + bit);
-                for c in out[at..at + 12].chunks_exact_mut(4) {
-                    c.copy_from_slice(&f32::NAN.to_be_bytes());
-                }
-            }
-        }
-    }
-    if !all_finite(&frame.positions) {
-        let bad = frame
-            .positions
-            .chunks_exact(3)
-            .enumerate()
-            .find(|(m, xyz)| !frame.is_missing(*m) && !xyz.iter().all(|v| v.is_finite()));
-        if let Some((marker, _)) = bad {
-            out.truncate(start);
-            return Err(EncodeError::NonFinite { marker });
-        }
-    }
-    Ok(())
-}
-
-/// Encodes `frame` in the flat form `/mocap/frame ,ih f...` (NaN for missing markers), for
-/// sources and tests that speak it. Returns the encoded length.
-///
-/// # Errors
-/// [`EncodeError::NonFinite`] if a present marker holds NaN or Inf.
-pub fn encode_frame_flat_into(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<usize, EncodeError> {
-    out.clear();
-    let h = frame.header;
-    wire::put_str_unchecked(out, FRAME);
-    out.extend_from_slice(b",ih");
-    out.resize(out.len() + frame.positions.len(), b'f');
-    out.push(0);
-    wire::pad_to4(out, 0);
-    wire::put_i32(out, h.frame_number);
-    wire::put_i64(out, h.capture_time_us);
-    for (m, xyz) in frame.positions.chunks_exact(3).enumerate() {
-        let missing = frame.is_missing(m);
-        if !missing && !xyz.iter().all(|v| v.is_finite()) {
-            out.clear();
-            return Err(EncodeError::NonFinite { marker: m });
-        }
-        for &v in xyz {
-            wire::put_f32(out, if missing { f32::NAN } else { v });
-        }
-    }
-    Ok(out.len())
 }
 
 #[cfg(test)]

@@ -1,0 +1,101 @@
+//! Streams made on their first frame, and edit controls applied to a stream's edit state.
+
+use std::sync::Arc;
+
+use ica_core::model::IcaModel;
+use protocol::Control;
+
+use crate::serve::edit_state::EditRefused;
+use crate::serve::streams::{Performer, Stream, StreamKey};
+
+/// A new stream for `key` on its performer's model (or the default one, with the template's
+/// edit settings); `None` when its labels share none with the model.
+pub(super) fn new_stream(
+    key: &StreamKey,
+    source_labels: &[String],
+    performers: &[Performer],
+    default_model: &Arc<IcaModel>,
+    template: &crate::serve::edit_state::EditState,
+    lowpass_s: f32,
+) -> Option<Stream> {
+    let performer = performers.iter().position(|p| p.owns(key));
+    let p = performer.map(|i| &performers[i]);
+    let model = p
+        .and_then(|p| p.model.clone())
+        .unwrap_or_else(|| Arc::clone(default_model));
+    let mut stream = Stream::new(Arc::clone(&model), performer, source_labels, lowpass_s).ok()?;
+    if Arc::ptr_eq(&model, default_model) {
+        stream.edit.copy_settings(template);
+    }
+    if let Some(p) = p {
+        defaults_of(p, &mut stream);
+    }
+    Some(stream)
+}
+
+/// A performer's default emotion, set at once (no ramp) on a new stream.
+fn defaults_of(p: &Performer, stream: &mut Stream) {
+    stream.edit.set_ramp(0.0);
+    if let Some(target) = &p.target {
+        let _ = apply_edit(
+            &mut stream.edit,
+            &stream.model,
+            &Control::Target(target.clone()),
+        );
+    }
+    if let Some(amount) = p.amount {
+        let _ = stream.edit.set_amount(amount);
+    }
+    stream
+        .edit
+        .set_ramp(crate::serve::edit_state::DEFAULT_RAMP_S);
+}
+
+/// The stream's source labels, rebuilt from its map for a model swap (unmapped source markers
+/// get placeholder names that match nothing).
+pub(super) fn source_labels(map: &crate::layout::LabelMap, model_labels: &[String]) -> Vec<String> {
+    let n = map
+        .model_to_take
+        .iter()
+        .flatten()
+        .chain(map.extra.iter())
+        .max()
+        .map_or(0, |m| m + 1);
+    let mut labels: Vec<String> = (0..n).map(|i| format!("\u{0}unmapped{i}")).collect();
+    for (i, t) in map.model_to_take.iter().enumerate() {
+        if let Some(t) = t {
+            labels[*t] = model_labels[i].clone();
+        }
+    }
+    labels
+}
+
+/// Applies one edit control to one stream's state, validated against its model.
+pub fn apply_edit(
+    edit: &mut crate::serve::edit_state::EditState,
+    model: &IcaModel,
+    control: &Control,
+) -> Result<(), EditRefused> {
+    match control {
+        Control::Target(name) => {
+            let level = model.emotion().levels.get(name).copied();
+            match (model.emotion().component, level) {
+                (None, _) => Err(EditRefused::NoEmotion),
+                (Some(_), None) => Err(EditRefused::UnknownEmotion { name: name.clone() }),
+                (Some(_), Some(level)) => edit.set_target(name, level as f32),
+            }
+        }
+        Control::Amount(a) => edit.set_amount(*a),
+        Control::Ramp(r) => {
+            edit.set_ramp(*r);
+            Ok(())
+        }
+        Control::Alpha { component, value } => edit.set_alpha(*component, *value),
+        Control::Gain { component, gain } => edit.set_gain(*component, *gain),
+        Control::Bypass(b) => {
+            edit.set_bypass(*b);
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
