@@ -18,11 +18,15 @@ use super::sender::Fanout;
 use super::stats::Stats;
 
 /// The processing thread merges its counters and histograms into the shared [`Stats`] (a
-/// lock, a histogram add and reset: tens of µs) only between bursts: when its queue is empty
-/// and this long has passed since the last merge, after 50 ms idle, or after a command.
+/// lock, a histogram add and reset: tens of µs) only between bursts, at most this often: with
+/// a steady source, while it waits for the next tick with [`QUIET`] to spare (right after a
+/// frame, the next performer's frame of the same tick may be on its way); otherwise when its
+/// queue is empty; and after 50 ms idle or a command.
 const MERGE_EVERY: Duration = Duration::from_millis(100);
 /// ... and at least this often under sustained load, when the queue is never empty.
 const MERGE_AT_LEAST: Duration = Duration::from_secs(1);
+/// Time to spare before the next tick for a merge.
+const QUIET: Duration = Duration::from_millis(2);
 /// The processing thread parks at most this long between two looks at its counters.
 const IDLE: Duration = Duration::from_millis(50);
 /// One received datagram.
@@ -105,7 +109,15 @@ impl Processing {
                     }
                     (IDLE, true)
                 }
-                Wait::ParkUntil(at) => ((at - now).min(IDLE), false),
+                Wait::ParkUntil(at) => {
+                    if at - now > QUIET && last_merge.elapsed() >= MERGE_EVERY {
+                        self.merge_stats();
+                        self.housekeeping();
+                        last_merge = Instant::now();
+                        continue;
+                    }
+                    ((at - now).min(IDLE), false)
+                }
                 Wait::Park => (IDLE, true),
             };
             crossbeam_channel::select! {
@@ -114,8 +126,9 @@ impl Processing {
                         self.arrival.frame_arrived(frame.received);
                         self.process(frame);
                         let since = last_merge.elapsed();
+                        let unsteady = self.arrival.period().is_none();
                         if since >= MERGE_AT_LEAST
-                            || (since >= MERGE_EVERY && self.frame_rx.is_empty())
+                            || (unsteady && since >= MERGE_EVERY && self.frame_rx.is_empty())
                         {
                             self.merge_stats();
                             self.housekeeping();
