@@ -43,11 +43,18 @@ fn bench_model(c: &mut Criterion, name: &str, model: IcaModel) {
         })
     });
     let glitches = pipeline.counters.glitches;
-    assert_eq!(glitches, 0, "{name}: the loose checks rejected {glitches} samples");
+    assert_eq!(
+        glitches, 0,
+        "{name}: the loose checks rejected {glitches} samples"
+    );
 }
 
 fn whole_frame_path(c: &mut Criterion) {
-    bench_model(c, "pipeline 109 markers m=20 compact", random_model(109, 20, 1));
+    bench_model(
+        c,
+        "pipeline 109 markers m=20 compact",
+        random_model(109, 20, 1),
+    );
     let mut checked = random_model(109, 20, 1);
     let centre = checked
         .mean()
@@ -62,8 +69,14 @@ fn whole_frame_path(c: &mut Criterion) {
         }),
         ..CaptureSettings::default()
     };
-    checked.set_capture(capture).expect("bounds for every marker");
-    bench_model(c, "pipeline 109 markers m=20 compact, glitch checks", checked);
+    checked
+        .set_capture(capture)
+        .expect("bounds for every marker");
+    bench_model(
+        c,
+        "pipeline 109 markers m=20 compact, glitch checks",
+        checked,
+    );
 }
 
 criterion_group!(benches, whole_frame_path);
