@@ -126,7 +126,9 @@ impl Processing {
                         self.arrival.frame_arrived(frame.received);
                         self.process(frame);
                         let since = last_merge.elapsed();
-                        let unsteady = self.arrival.period().is_none();
+                        // No tick to wait for (no beat, or one too fast or missed): merge
+                        // whenever the queue runs empty, as there is no better gap coming.
+                        let unsteady = self.arrival.plan(Instant::now()) == Wait::Park;
                         if since >= MERGE_AT_LEAST
                             || (unsteady && since >= MERGE_EVERY && self.frame_rx.is_empty())
                         {
