@@ -15,6 +15,7 @@ use super::control::Cmd;
 use super::pipeline::{Emitted, Pipeline};
 use super::record::Recording;
 use super::sender::Fanout;
+use super::server::Answer;
 use super::stats::Stats;
 
 /// The processing thread merges its counters and histograms into the shared [`Stats`] (a
@@ -60,6 +61,8 @@ pub(crate) struct Processing {
     stats: Arc<Mutex<Stats>>,
     queue_dropped: Arc<AtomicU64>,
     recording: Option<Recording>,
+    /// Recordings being closed on their own threads.
+    closing: Vec<std::thread::JoinHandle<()>>,
     processed_us: hdrhistogram::Histogram<u64>,
 }
 
@@ -87,6 +90,7 @@ impl Processing {
             stats,
             queue_dropped,
             recording: None,
+            closing: Vec::new(),
             processed_us: Stats::histogram(),
         };
         processing.pipeline.set_wanted(processing.fanout.wanted());
@@ -100,31 +104,45 @@ impl Processing {
             let now = Instant::now();
             // `idle`: the timeout below means nothing came for a while (not a planned wake-up
             // before the next beat), a good moment for the counters.
-            let (timeout, idle) = match self.arrival.plan(now) {
-                Wait::PollUntil(until) => {
-                    if self.poll_until(until) {
-                        self.poll_hits += 1;
-                    } else {
-                        self.poll_misses += 1;
+            let (timeout, idle) = if !self.frame_rx.is_empty() {
+                (Duration::ZERO, false)
+            } else {
+                match self.arrival.plan(now) {
+                    Wait::PollUntil(until) => {
+                        if self.poll_until(until) {
+                            self.poll_hits += 1;
+                        } else {
+                            self.poll_misses += 1;
+                        }
+                        (IDLE, true)
                     }
-                    (IDLE, true)
-                }
-                Wait::ParkUntil(at) => {
-                    if at - now > QUIET && last_merge.elapsed() >= MERGE_EVERY {
-                        self.merge_stats();
-                        self.housekeeping();
-                        last_merge = Instant::now();
-                        continue;
+                    Wait::ParkUntil(at) => {
+                        let due = last_merge.elapsed() >= MERGE_EVERY && at - now > QUIET;
+                        match self.arrival.burst_end() {
+                            // Merge in the gap, once this tick's frames are all in.
+                            Some(end) if due && end > now => ((end - now).min(at - now), false),
+                            _ if due && self.cmd_rx.is_empty() => {
+                                self.merge_stats();
+                                self.housekeeping();
+                                last_merge = Instant::now();
+                                continue;
+                            }
+                            _ => ((at - now).min(IDLE), false),
+                        }
                     }
-                    ((at - now).min(IDLE), false)
+                    Wait::Park => (IDLE, true),
                 }
-                Wait::Park => (IDLE, true),
             };
             crossbeam_channel::select! {
                 recv(self.frame_rx) -> msg => match msg {
                     Ok(frame) => {
-                        self.arrival.frame_arrived(frame.received);
+                        let received = frame.received;
+                        let frames_before = self.pipeline.counters.frames_in;
                         self.process(frame);
+                        // Only frames set the beat: labels, bad packets and noise do not.
+                        if self.pipeline.counters.frames_in > frames_before {
+                            self.arrival.frame_arrived(received);
+                        }
                         let since = last_merge.elapsed();
                         // No tick to wait for (no beat, or one too fast or missed): merge
                         // whenever the queue runs empty, as there is no better gap coming.
@@ -155,17 +173,21 @@ impl Processing {
         if let Some(rec) = self.recording.take() {
             finish_recording(rec);
         }
+        // Shutdown waits for every file to be complete.
+        for closing in self.closing.drain(..) {
+            let _ = closing.join();
+        }
     }
 
-    /// Polls the queues until something comes (`true`) or `until`. No `spin_loop` hint: a
-    /// hypervisor may take a run of PAUSE instructions as lock contention and deschedule the
-    /// CPU.
+    /// Polls the queues until something comes or `until`; `true` when a frame came. No
+    /// `spin_loop` hint: a hypervisor may take a run of PAUSE instructions as lock contention
+    /// and deschedule the CPU.
     fn poll_until(&self, until: Instant) -> bool {
         loop {
-            if !self.frame_rx.is_empty() || !self.cmd_rx.is_empty() {
+            if !self.frame_rx.is_empty() {
                 return true;
             }
-            if Instant::now() >= until {
+            if !self.cmd_rx.is_empty() || Instant::now() >= until {
                 return false;
             }
         }
@@ -199,8 +221,9 @@ impl Processing {
         let _ = self.free_tx.try_send(frame.bytes);
     }
 
-    /// Between frames: subscriptions whose lease ended.
+    /// Between frames: subscriptions whose lease ended; recordings done closing.
     fn housekeeping(&mut self) {
+        self.closing.retain(|h| !h.is_finished());
         if self.fanout.expire(Instant::now()) {
             self.pipeline.set_wanted(self.fanout.wanted());
         }
@@ -241,20 +264,20 @@ impl Processing {
                 let _ = reply.send(Ok(()));
             }
             Cmd::RecordStart(path, raw, reply) => {
-                if let Some(rec) = self.recording.take() {
-                    finish_recording(rec);
-                }
-                let r =
-                    Recording::start(&path, raw.as_deref()).map(|rec| self.recording = Some(rec));
+                // The new recording is checked first: a bad path leaves the old one running.
+                let r = Recording::start(&path, raw.as_deref()).map(|rec| {
+                    if let Some(old) = self.recording.replace(rec) {
+                        self.closing.push(close_in_background(old, None));
+                    }
+                });
                 let _ = reply.send(r.map_err(|e| e.to_string()));
             }
-            Cmd::RecordStop(reply) => {
-                let r = match self.recording.take() {
-                    Some(rec) => rec.finish().map(|_| ()).map_err(|e| e.to_string()),
-                    None => Err("no recording in progress".to_string()),
-                };
-                let _ = reply.send(r);
-            }
+            Cmd::RecordStop(reply) => match self.recording.take() {
+                Some(rec) => self.closing.push(close_in_background(rec, Some(reply))),
+                None => {
+                    let _ = reply.send(Err("no recording in progress".to_string()));
+                }
+            },
         }
     }
 }
@@ -263,4 +286,18 @@ fn finish_recording(rec: Recording) {
     if let Err(e) = rec.finish() {
         tracing::warn!(error = %e, "recording failed");
     }
+}
+
+/// Closes a recording on its own thread (each file ends with an fsync, which must not hold up
+/// the frames), answering `reply` when done.
+fn close_in_background(rec: Recording, reply: Option<Answer>) -> std::thread::JoinHandle<()> {
+    std::thread::spawn(move || {
+        let r = rec.finish().map(|_| ()).map_err(|e| e.to_string());
+        if let Err(e) = &r {
+            tracing::warn!(error = %e, "recording failed");
+        }
+        if let Some(reply) = reply {
+            let _ = reply.send(r);
+        }
+    })
 }
