@@ -3,10 +3,14 @@
 //! `/record/stop` or shutdown.
 //!
 //! Each stream (source address + layout) gets its own files, so performers never mix: the
-//! first stream seen writes to the paths given, the k-th to `<stem>.<k>.<ext>`. The edited
+//! first stream seen writes to the paths given, the next ones to `<stem>.<k>.<ext>` with the
+//! first `k` from 2 whose names are not taken by this recording. A stream whose labels change
+//! mid-take (a model swap, a relabelled source) continues in a new numbered file. The edited
 //! file holds the model's markers as sent (gaps filled by the model); the raw file holds
 //! every marker the source sent, under its own labels, with its gaps, before any
-//! stabilisation or glitch rejection: nothing the stage sent is lost.
+//! stabilisation or glitch rejection. Both hold the frames the daemon processed for the
+//! stream; frame numbers lost or dropped on the way are written as all-missing rows, so the
+//! timing stays true.
 
 use std::path::{Path, PathBuf};
 
@@ -48,57 +52,84 @@ pub enum RecordError {
     },
 }
 
+/// Lost frame numbers filled with all-missing rows at most (a minute at 120 Hz); a longer
+/// pause is written as if it had not happened, and logged.
+const MAX_FILL: u32 = 7_200;
+
 /// One file being written, opened on its first frame (which fixes labels, rate and the first
-/// frame number). A write error stops this file (logged once); what was written stays.
+/// frame number). A write error stops this file (logged once, reported when it is closed);
+/// what was written stays.
 #[derive(Debug)]
 struct Sink {
     path: PathBuf,
+    labels: Vec<String>,
     recorder: Option<Recorder>,
-    failed: bool,
+    error: Option<String>,
+    gaps: Vec<bool>,
+    blank: Vec<f32>,
 }
 
 impl Sink {
-    fn new(path: PathBuf) -> Sink {
+    fn new(path: PathBuf, labels: &[String]) -> Sink {
         Sink {
             path,
+            labels: labels.to_vec(),
             recorder: None,
-            failed: false,
+            error: None,
+            gaps: vec![true; labels.len()],
+            blank: vec![0.0; labels.len() * 3],
         }
     }
 
-    fn push(&mut self, labels: &[String], rate_hz: f64, first: i32, xyz: &[f32], gaps: &[bool]) {
-        if self.failed || xyz.len() != labels.len() * 3 || gaps.len() != labels.len() {
+    /// Appends one frame, after `lost` all-missing rows.
+    fn push(&mut self, frame: (f64, i32, u32), xyz: &[f32], gaps: &[bool]) {
+        let (rate_hz, number, lost) = frame;
+        if self.error.is_some() || xyz.len() != self.labels.len() * 3 {
             return;
         }
         if self.recorder.is_none() {
-            match Recorder::create(&self.path, labels.to_vec(), rate_hz, i64::from(first)) {
+            match Recorder::create(&self.path, self.labels.clone(), rate_hz, i64::from(number)) {
                 Ok(r) => self.recorder = Some(r),
                 Err(e) => return self.fail(&e),
             }
-        }
-        if let Some(r) = self.recorder.as_mut() {
-            if let Err(e) = r.push_frame(xyz, gaps) {
-                self.fail(&e);
+        } else if lost > MAX_FILL {
+            tracing::warn!(path = %self.path.display(), lost, "long pause not filled");
+        } else {
+            for _ in 0..lost {
+                if let Some(Err(e)) = self
+                    .recorder
+                    .as_mut()
+                    .map(|r| r.push_frame(&self.blank, &self.gaps))
+                {
+                    return self.fail(&e);
+                }
             }
+        }
+        if let Some(Err(e)) = self.recorder.as_mut().map(|r| r.push_frame(xyz, gaps)) {
+            self.fail(&e);
         }
     }
 
     fn fail(&mut self, e: &replay::WriteError) {
-        self.failed = true;
         tracing::warn!(path = %self.path.display(), error = %e, "recording stopped");
+        self.error = Some(e.to_string());
     }
 
     /// Closes the file; frames written.
     fn finish(self) -> Result<u64, RecordError> {
-        let Some(r) = self.recorder else {
-            return Ok(0);
-        };
-        let summary = r.finish().map_err(|e| RecordError::Write {
+        let write_error = |message: String| RecordError::Write {
             path: self.path.display().to_string(),
-            message: e.to_string(),
-        })?;
-        tracing::info!(path = %self.path.display(), frames = summary.frames, "recording closed");
-        Ok(summary.frames)
+            message,
+        };
+        let frames = match self.recorder {
+            Some(r) => r.finish().map_err(|e| write_error(e.to_string()))?.frames,
+            None => 0,
+        };
+        tracing::info!(path = %self.path.display(), frames, "recording closed");
+        match self.error {
+            Some(e) => Err(write_error(format!("stopped after {frames} frames: {e}"))),
+            None => Ok(frames),
+        }
     }
 }
 
@@ -110,21 +141,38 @@ struct StreamFiles {
     raw: Option<Sink>,
 }
 
+impl StreamFiles {
+    /// Whether these files were opened for a frame with these labels.
+    fn fits(&self, e: &Emitted<'_>) -> bool {
+        self.edited.labels == e.labels
+            && self.raw.as_ref().is_none_or(|r| r.labels == e.input_labels)
+    }
+}
+
 /// One recording in progress (bounded memory: [`Recorder`] streams to disk).
 #[derive(Debug)]
 pub struct Recording {
     path: PathBuf,
     raw: Option<PathBuf>,
+    /// Files of streams still recording.
     streams: Vec<StreamFiles>,
+    /// Files of streams whose labels changed: closed at the end.
+    retired: Vec<StreamFiles>,
+    /// Every path this recording writes, absolute, so no two files share one.
+    taken: Vec<PathBuf>,
     /// The model has no gaps to mark in the edited stream: all `false`, grown as needed.
     no_gaps: Vec<bool>,
     /// The input's gaps, source order.
     input_gaps: Vec<bool>,
 }
 
-/// `.c3d`, `.trc` or `.csv` (any case), and the file can be created, so `/record/start`
-/// answers with the error at once, not at the end.
-fn check(path: &Path) -> Result<(), RecordError> {
+/// `path` made absolute (not resolving links), for comparing paths given differently.
+fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
+/// `.c3d`, `.trc` or `.csv` (any case).
+fn check_extension(path: &Path) -> Result<(), RecordError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -134,6 +182,11 @@ fn check(path: &Path) -> Result<(), RecordError> {
             path: path.display().to_string(),
         });
     }
+    Ok(())
+}
+
+/// The file can be created, so `/record/start` answers with the error at once.
+fn check_creatable(path: &Path) -> Result<(), RecordError> {
     std::fs::File::create(path).map_err(|source| RecordError::Io {
         path: path.display().to_string(),
         source,
@@ -164,19 +217,24 @@ impl Recording {
     /// # Errors
     /// [`RecordError::Extension`], [`RecordError::SamePath`] or [`RecordError::Io`].
     pub fn start(path: &Path, raw: Option<&Path>) -> Result<Recording, RecordError> {
-        if raw == Some(path) {
+        if raw.is_some_and(|raw| absolute(raw) == absolute(path)) {
             return Err(RecordError::SamePath {
                 path: path.display().to_string(),
             });
         }
-        check(path)?;
+        // Every check before any file is created, so a refused start truncates nothing.
+        check_extension(path)?;
+        raw.map(check_extension).transpose()?;
         if let Some(raw) = raw {
-            check(raw)?;
+            check_creatable(raw)?;
         }
+        check_creatable(path)?;
         Ok(Recording {
             path: path.to_path_buf(),
             raw: raw.map(Path::to_path_buf),
             streams: Vec::new(),
+            retired: Vec::new(),
+            taken: Vec::new(),
             no_gaps: Vec::new(),
             input_gaps: Vec::new(),
         })
@@ -185,38 +243,55 @@ impl Recording {
     /// Appends one processed frame to its stream's files (opened on the stream's first frame).
     pub fn push(&mut self, e: &Emitted<'_>) {
         let i = match self.streams.iter().position(|s| s.key == e.key) {
-            Some(i) => i,
-            None => self.open(e.key),
+            Some(i) if self.streams[i].fits(e) => i,
+            Some(i) => {
+                tracing::info!(source = %e.key.source, "labels changed: recording to new files");
+                let old = self.streams.swap_remove(i);
+                self.retired.push(old);
+                self.open(e)
+            }
+            None => self.open(e),
         };
+        let frame = (
+            e.rate_hz,
+            e.frame_number,
+            e.frames_since_last.saturating_sub(1),
+        );
         if self.no_gaps.len() < e.labels.len() {
             self.no_gaps.resize(e.labels.len(), false);
         }
         let files = &mut self.streams[i];
         let gaps = &self.no_gaps[..e.labels.len()];
-        files
-            .edited
-            .push(e.labels, e.rate_hz, e.frame_number, e.xyz, gaps);
+        files.edited.push(frame, e.xyz, gaps);
         if let Some(raw) = files.raw.as_mut() {
             let n = e.input.marker_count();
             self.input_gaps.clear();
             self.input_gaps
                 .extend((0..n).map(|i| e.input.is_missing(i)));
             let xyz = &e.input.positions()[..n * 3];
-            raw.push(
-                e.input_labels,
-                e.rate_hz,
-                e.frame_number,
-                xyz,
-                &self.input_gaps,
-            );
+            raw.push(frame, xyz, &self.input_gaps);
+        }
+    }
+
+    /// The first free name for a new stream's file.
+    fn free_path(&mut self, base: &Path) -> PathBuf {
+        let mut k = 1;
+        loop {
+            let p = stream_path(base, k);
+            let abs = absolute(&p);
+            if !self.taken.contains(&abs) {
+                self.taken.push(abs);
+                return p;
+            }
+            k += 1;
         }
     }
 
     /// A new stream's files; its index.
-    fn open(&mut self, key: StreamKey) -> usize {
-        let k = self.streams.len() + 1;
-        let edited = stream_path(&self.path, k);
-        let raw = self.raw.as_deref().map(|p| stream_path(p, k));
+    fn open(&mut self, e: &Emitted<'_>) -> usize {
+        let key = e.key;
+        let edited = self.free_path(&self.path.clone());
+        let raw = self.raw.clone().map(|p| self.free_path(&p));
         tracing::info!(
             source = %key.source,
             layout = key.layout_id,
@@ -226,8 +301,8 @@ impl Recording {
         );
         self.streams.push(StreamFiles {
             key,
-            edited: Sink::new(edited),
-            raw: raw.map(Sink::new),
+            edited: Sink::new(edited, e.labels),
+            raw: raw.map(|p| Sink::new(p, e.input_labels)),
         });
         self.streams.len() - 1
     }
@@ -240,7 +315,7 @@ impl Recording {
     pub fn finish(self) -> Result<u64, RecordError> {
         let mut frames = 0;
         let mut first_error = None;
-        for s in self.streams {
+        for s in self.streams.into_iter().chain(self.retired) {
             for (sink, edited) in std::iter::once((s.edited, true)).chain(s.raw.map(|r| (r, false)))
             {
                 match sink.finish() {
@@ -300,6 +375,7 @@ mod tests {
         Emitted {
             key,
             frame_number: n,
+            frames_since_last: 1,
             compact: &[],
             parts: &[],
             part_ends: &[],
@@ -343,5 +419,72 @@ mod tests {
             assert!(take.frame(4)[..3] == [k, 0.0, 0.0], "{}", path.display());
             assert_eq!(take.is_missing(2, 1), gaps, "{}", path.display());
         }
+    }
+
+    fn key(port: u16) -> StreamKey {
+        StreamKey {
+            source: SocketAddr::from(([127, 0, 0, 1], port)),
+            layout_id: 0,
+        }
+    }
+
+    #[test]
+    fn numbered_names_never_collide_with_the_paths_given() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let (edited, raw) = (dir.path().join("take.csv"), dir.path().join("take.2.csv"));
+        let mut rec = Recording::start(&edited, Some(&raw)).expect("paths are fine");
+        let labels: Vec<String> = vec!["a".into()];
+        let mut input = protocol::FrameBuf::with_max_markers(1);
+        for (k, port) in [(1.0, 7000), (2.0, 7001)] {
+            let xyz = [k, 0.0, 0.0];
+            input.set_frame(0, 0, &xyz).expect("finite");
+            rec.push(&emitted(key(port), 0, &labels, &xyz, &input));
+        }
+        rec.finish().expect("closes");
+        // stream 2's edited file skips take.2.csv, which is stream 1's raw file
+        for (name, k) in [
+            ("take.csv", 1.0),
+            ("take.2.csv", 1.0),
+            ("take.3.csv", 2.0),
+            ("take.2.2.csv", 2.0),
+        ] {
+            let take = replay::load(&dir.path().join(name)).expect(name);
+            assert_eq!(take.frame(0)[0], k, "{name}");
+        }
+    }
+
+    #[test]
+    fn lost_frames_become_gaps_and_new_labels_a_new_file() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("take.csv");
+        let mut rec = Recording::start(&path, None).expect("path is fine");
+        let (one, two): (Vec<String>, Vec<String>) = (vec!["a".into()], vec!["b".into()]);
+        let input = protocol::FrameBuf::with_max_markers(1);
+        for (n, since) in [(0, 1), (1, 1), (4, 3)] {
+            let mut e = emitted(key(7000), n, &one, &[1.0, 2.0, 3.0], &input);
+            e.frames_since_last = since;
+            rec.push(&e);
+        }
+        rec.push(&emitted(key(7000), 5, &two, &[4.0, 5.0, 6.0], &input));
+        rec.finish().expect("closes");
+        let take = replay::load(&path).expect("loads");
+        assert_eq!(take.n_frames(), 5, "frames 0..=4, two of them lost");
+        let gaps: Vec<bool> = (0..5).map(|f| take.is_missing(f, 0)).collect();
+        assert_eq!(gaps, [false, false, true, true, false]);
+        let relabelled = replay::load(&stream_path(&path, 2)).expect("a second file");
+        assert_eq!(relabelled.labels, two);
+        assert_eq!(relabelled.first_frame, 5);
+    }
+
+    #[test]
+    fn a_refused_start_truncates_nothing() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("take.csv");
+        std::fs::write(&path, "keep me").expect("write");
+        let bad_raw = dir.path().join("missing/raw.csv");
+        assert!(Recording::start(&path, Some(&bad_raw)).is_err());
+        assert!(Recording::start(&path, Some(&dir.path().join("raw.txt"))).is_err());
+        assert!(Recording::start(&path, Some(&dir.path().join("./take.csv"))).is_err());
+        assert_eq!(std::fs::read_to_string(&path).expect("read"), "keep me");
     }
 }

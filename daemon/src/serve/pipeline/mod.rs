@@ -38,6 +38,9 @@ pub struct Emitted<'a> {
     pub key: StreamKey,
     /// Frame number.
     pub frame_number: i32,
+    /// Frame numbers since the stream's previous processed frame: 1 when none was lost or
+    /// dropped on the way (and for a stream's first frame or a restart).
+    pub frames_since_last: u32,
     /// Compact bundle (empty when not wanted).
     pub compact: &'a [u8],
     /// Flat-split parts, concatenated; see `part_ends`.
@@ -335,6 +338,7 @@ impl Pipeline {
         emit(&Emitted {
             key,
             frame_number: header.frame_number,
+            frames_since_last: frames,
             compact: &self.compact,
             parts: &self.parts,
             part_ends: &self.part_ends,
