@@ -151,10 +151,15 @@ pub(super) async fn through_daemon(
     };
     raw.send = addrs.iter().map(|a| a.to_string()).collect();
     let daemon = Daemon::start(raw.validate()?, model.clone()).await?;
-    let sent = send_all(model, performers, daemon.frames, rate_hz, secs).await?;
-    tokio::time::sleep(Duration::from_millis(200)).await;
-    let status = status(daemon.control).await?;
+    let traffic = async {
+        let sent = send_all(model, performers, daemon.frames, rate_hz, secs).await?;
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        anyhow::Ok((sent, status(daemon.control).await?))
+    }
+    .await;
+    // Stopped whatever happened, so a failed run leaves no daemon behind.
     daemon.stop().await?;
+    let (sent, status) = traffic?;
     Ok(Run {
         seen: collect(receivers).await,
         sent,

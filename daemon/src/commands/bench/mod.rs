@@ -70,14 +70,15 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         crate::out!("  {name}: {} of ~{sent} datagrams received", s.received);
     }
     crate::out!(
-        "  inside the daemon: received -> processed p50 {} µs, p99 {} µs; processed -> sent p50 {} µs, p99 {} µs",
+        "  inside the daemon (last round): received -> processed p50 {} µs, p99 {} µs; \
+         processed -> sent p50 {} µs, p99 {} µs",
         daemon.get("processed_p50_us"),
         daemon.get("processed_p99_us"),
         daemon.get("sent_p50_us"),
         daemon.get("sent_p99_us"),
     );
     crate::out!(
-        "  frames caught by polling around the beat: {} of {} windows",
+        "  frames caught by polling around the beat (last round): {} of {} windows",
         daemon.get("poll_hits"),
         daemon.get("poll_hits") + daemon.get("poll_misses"),
     );
@@ -109,8 +110,9 @@ fn print_max_rate(max: &Run) -> Result<()> {
     crate::out!(
         "  lost at the daemon's socket {}, dropped in the daemon {} (queue full {}, stale {}), \
          not sent {}, lost at the receiver's socket {}",
-        max.sent as i64 - frames_in,
-        frames_in - max.get("frames_out"),
+        // Queue drops happen before the pipeline counts a frame in.
+        max.sent as i64 - frames_in - max.get("frames_dropped"),
+        frames_in - max.get("frames_out") + max.get("frames_dropped"),
         max.get("frames_dropped"),
         max.get("dropped_stale"),
         max.get("dropped_send_buffer") + max.get("send_errors"),
