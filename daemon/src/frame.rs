@@ -15,6 +15,7 @@
 use ica_core::model::{CaptureSettings, IcaModel};
 use ica_core::project::{FrameError, FrameStatus, Projector};
 use ica_core::stabilise::{self, Pose, Stabiliser};
+use protocol::all_finite;
 
 /// A glitching marker is believed again after this long (seconds) of rejected samples in a
 /// row, so a marker that really moved (or was relabelled for good) is not lost forever. Long
@@ -263,24 +264,6 @@ fn any(flags: &[bool]) -> bool {
 
 fn sq(v: f32) -> f32 {
     v * v
-}
-
-/// Whether every value is finite, without an early exit so it vectorises (integer arithmetic
-/// on the exponent bits, four lanes per SSE2 op): a clean frame is checked in one pass
-/// instead of a scalar test and branch per coordinate.
-fn all_finite(values: &[f32]) -> bool {
-    const EXP: u32 = 0x7f80_0000;
-    let chunks = values.chunks_exact(8);
-    let tail = chunks.remainder().iter().all(|v| v.is_finite());
-    // An all-ones exponent (Inf, NaN) plus its lowest bit carries into bit 31; any other
-    // exponent stays below it. Mask, add, or: three plain vector ops per four floats.
-    let mut bits = [0_u32; 8];
-    for c in chunks {
-        for i in 0..8 {
-            bits[i] |= (c[i].to_bits() & EXP) + 0x0080_0000;
-        }
-    }
-    tail && bits.iter().fold(0, |a, b| a | b) >> 31 == 0
 }
 
 /// Per-frame processor for one stream or take. See the module docs for the steps.

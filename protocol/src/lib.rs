@@ -99,8 +99,8 @@ pub use address::Address;
 pub use control::{decode_control, decode_osc, Control, ControlError, Profile};
 pub use error::{DecodeError, DecodeErrorKind, EncodeError};
 pub use frame::{
-    decode_frame_into, encode_frame_flat_into, encode_frame_into, frame_message_len, FrameBuf,
-    FrameForm, FrameHeader, MAX_FRAME_MARKERS,
+    all_finite, decode_frame_into, encode_frame_flat_into, encode_frame_into, frame_message_len,
+    FrameBuf, FrameForm, FrameHeader, MAX_FRAME_MARKERS,
 };
 pub use labels::{
     decode_labels, encode_labels_into, Labels, LayoutBook, LayoutChange, MAX_LAYOUTS_PER_SOURCE,

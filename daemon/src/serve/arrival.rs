@@ -82,12 +82,6 @@ impl ArrivalClock {
         self.period
     }
 
-    /// Whether the current tick's burst is over at `now` (no more frames of it expected).
-    pub fn burst_over(&self, now: Instant) -> bool {
-        self.burst_start
-            .is_none_or(|start| now.saturating_duration_since(start) >= BURST)
-    }
-
     /// When the current tick's burst is over.
     pub fn burst_end(&self) -> Option<Instant> {
         self.burst_start.map(|start| start + BURST)

@@ -63,6 +63,8 @@ pub(crate) struct Processing {
     recording: Option<Recording>,
     /// Recordings being closed on their own threads.
     closing: Vec<std::thread::JoinHandle<()>>,
+    /// When the counters were last merged into the shared stats.
+    last_merge: Instant,
     processed_us: hdrhistogram::Histogram<u64>,
 }
 
@@ -91,6 +93,7 @@ impl Processing {
             queue_dropped,
             recording: None,
             closing: Vec::new(),
+            last_merge: Instant::now(),
             processed_us: Stats::histogram(),
         };
         processing.pipeline.set_wanted(processing.fanout.wanted());
@@ -99,62 +102,15 @@ impl Processing {
 
     /// Runs until the receive task closes the queue, then closes the recording.
     pub(crate) fn run(mut self) {
-        let mut last_merge = Instant::now();
         loop {
-            let now = Instant::now();
-            // `idle`: the timeout below means nothing came for a while (not a planned wake-up
-            // before the next beat), a good moment for the counters.
-            let (timeout, idle) = if !self.frame_rx.is_empty() {
-                (Duration::ZERO, false)
-            } else {
-                match self.arrival.plan(now) {
-                    Wait::PollUntil(until) => {
-                        if self.poll_until(until) {
-                            self.poll_hits += 1;
-                        } else {
-                            self.poll_misses += 1;
-                        }
-                        (IDLE, true)
-                    }
-                    Wait::ParkUntil(at) => {
-                        let due = last_merge.elapsed() >= MERGE_EVERY && at - now > QUIET;
-                        match self.arrival.burst_end() {
-                            // Merge in the gap, once this tick's frames are all in.
-                            Some(end) if due && end > now => ((end - now).min(at - now), false),
-                            _ if due && self.cmd_rx.is_empty() => {
-                                self.merge_stats();
-                                self.housekeeping();
-                                last_merge = Instant::now();
-                                continue;
-                            }
-                            _ => ((at - now).min(IDLE), false),
-                        }
-                    }
-                    Wait::Park => (IDLE, true),
-                }
+            // `idle`: the timeout means nothing came for a while (not a planned wake-up before
+            // the next beat), a good moment for the counters.
+            let Some((timeout, idle)) = self.plan_wait() else {
+                continue;
             };
             crossbeam_channel::select! {
                 recv(self.frame_rx) -> msg => match msg {
-                    Ok(frame) => {
-                        let received = frame.received;
-                        let frames_before = self.pipeline.counters.frames_in;
-                        self.process(frame);
-                        // Only frames set the beat: labels, bad packets and noise do not.
-                        if self.pipeline.counters.frames_in > frames_before {
-                            self.arrival.frame_arrived(received);
-                        }
-                        let since = last_merge.elapsed();
-                        // No tick to wait for (no beat, or one too fast or missed): merge
-                        // whenever the queue runs empty, as there is no better gap coming.
-                        let unsteady = self.arrival.plan(Instant::now()) == Wait::Park;
-                        if since >= MERGE_AT_LEAST
-                            || (unsteady && since >= MERGE_EVERY && self.frame_rx.is_empty())
-                        {
-                            self.merge_stats();
-                            self.housekeeping();
-                            last_merge = Instant::now();
-                        }
-                    }
+                    Ok(frame) => self.on_frame(frame),
                     Err(_) => break,
                 },
                 recv(self.cmd_rx) -> cmd => if let Ok(cmd) = cmd {
@@ -162,11 +118,7 @@ impl Processing {
                     // So that a `/status` right after a command sees its effect.
                     self.merge_stats();
                 },
-                default(timeout) => if idle {
-                    self.merge_stats();
-                    self.housekeeping();
-                    last_merge = Instant::now();
-                },
+                default(timeout) => if idle { self.tidy() },
             }
         }
         self.merge_stats();
@@ -177,6 +129,64 @@ impl Processing {
         for closing in self.closing.drain(..) {
             let _ = closing.join();
         }
+    }
+
+    /// How long to wait for the next frame or command, and whether that wait means idle;
+    /// `None` when it merged the counters instead (in the gap before the next tick), so the
+    /// caller plans again.
+    fn plan_wait(&mut self) -> Option<(Duration, bool)> {
+        if !self.frame_rx.is_empty() {
+            return Some((Duration::ZERO, false));
+        }
+        let now = Instant::now();
+        match self.arrival.plan(now) {
+            Wait::PollUntil(until) => {
+                if self.poll_until(until) {
+                    self.poll_hits += 1;
+                } else {
+                    self.poll_misses += 1;
+                }
+                Some((IDLE, true))
+            }
+            Wait::ParkUntil(at) => {
+                let due = self.last_merge.elapsed() >= MERGE_EVERY && at - now > QUIET;
+                match self.arrival.burst_end() {
+                    // Merge in the gap, once this tick's frames are all in.
+                    Some(end) if due && end > now => Some(((end - now).min(at - now), false)),
+                    _ if due && self.cmd_rx.is_empty() => {
+                        self.tidy();
+                        None
+                    }
+                    _ => Some(((at - now).min(IDLE), false)),
+                }
+            }
+            Wait::Park => Some((IDLE, true)),
+        }
+    }
+
+    fn on_frame(&mut self, frame: InFrame) {
+        let received = frame.received;
+        let frames_before = self.pipeline.counters.frames_in;
+        self.process(frame);
+        // Only frames set the beat: labels, bad packets and noise do not.
+        if self.pipeline.counters.frames_in > frames_before {
+            self.arrival.frame_arrived(received);
+        }
+        let since = self.last_merge.elapsed();
+        // No tick to wait for (no beat, or one too fast or missed): merge whenever the queue
+        // runs empty, as there is no better gap coming.
+        let unsteady = self.arrival.plan(Instant::now()) == Wait::Park;
+        if since >= MERGE_AT_LEAST || (unsteady && since >= MERGE_EVERY && self.frame_rx.is_empty())
+        {
+            self.tidy();
+        }
+    }
+
+    /// Counters into the shared stats, then housekeeping.
+    fn tidy(&mut self) {
+        self.merge_stats();
+        self.housekeeping();
+        self.last_merge = Instant::now();
     }
 
     /// Polls the queues until something comes or `until`; `true` when a frame came. No

@@ -221,11 +221,12 @@ pub use decode::decode_frame_into;
 pub(crate) use encode::append_frame;
 pub use encode::{encode_frame_flat_into, encode_frame_into, frame_message_len};
 
-/// Whether every value is finite. No early exit, and integer arithmetic on the exponent bits,
+/// Whether every value is finite (positions on the wire and in the daemon's frame path).
+/// No early exit, and integer arithmetic on the exponent bits,
 /// so the loop vectorises on baseline SSE2; `iter().all(is_finite)` stops at
 /// the first bad value and runs one scalar compare and branch per float (~0.1 µs a 109-marker
 /// frame, measured, where this takes a fifth of that).
-pub(crate) fn all_finite(values: &[f32]) -> bool {
+pub fn all_finite(values: &[f32]) -> bool {
     const EXP: u32 = 0x7f80_0000;
     let chunks = values.chunks_exact(8);
     let tail = chunks.remainder().iter().all(|v| v.is_finite());
