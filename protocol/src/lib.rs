@@ -90,6 +90,7 @@ mod control;
 mod error;
 mod frame;
 mod labels;
+pub mod natnet;
 mod output;
 mod reply;
 mod scan;
