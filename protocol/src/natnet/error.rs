@@ -224,12 +224,6 @@ pub enum NatNetEncodeError {
         /// Minor version.
         minor: u8,
     },
-    /// The frame's parts do not fit together (a range beyond its backing list).
-    #[error("inconsistent frame: {what} range exceeds its list")]
-    Inconsistent {
-        /// Which part.
-        what: &'static str,
-    },
 }
 
 #[cfg(test)]

@@ -78,11 +78,13 @@
 //! ```
 
 mod client;
+mod client_types;
 mod command;
 mod error;
 mod frame;
 mod frame_decode;
 mod frame_encode;
+mod frame_parts;
 mod message;
 mod modeldef;
 mod modeldef_encode;

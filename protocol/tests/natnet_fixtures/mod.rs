@@ -40,7 +40,7 @@ pub fn traffic() -> Vec<Datagram> {
     let mut out = Vec::new();
     let mut i = 0;
     while i < d.len() {
-        let ts_us = u64::from_le_bytes(d[i..i + 8].try_into().unwrap());
+        let ts_us = u64::from_le_bytes(d[i..i + 8].try_into().expect("8 bytes"));
         let src_port = u16::from_le_bytes([d[i + 8], d[i + 9]]);
         let dst_port = u16::from_le_bytes([d[i + 10], d[i + 11]]);
         let n = usize::from(u16::from_le_bytes([d[i + 12], d[i + 13]]));
