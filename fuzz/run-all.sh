@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 runs="${RUNS:-1000000}"
-for t in frame datagram control labels outputs; do
+for t in frame datagram control labels outputs natnet; do
   mkdir -p "corpus/$t"
   cp -n seeds/* "corpus/$t/" 2>/dev/null || true
   start=$(date +%s)
