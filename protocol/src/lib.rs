@@ -1,4 +1,6 @@
-//! OSC 1.0 wire formats of emoshift: marker frames, labels, output profiles and control.
+//! OSC 1.0 wire formats of emoshift: marker frames, labels, output profiles and control; and
+//! [`natnet`], OptiTrack Motive's NatNet protocol (frames, model definitions, commands, a
+//! sans-IO client session) so the daemon can take Motive streams as a source.
 //!
 //! Sans-IO: every function takes bytes and returns values, or writes into a caller
 //! `Vec<u8>`. No sockets, no clock, no threads, no logging; the daemon owns all of those.
