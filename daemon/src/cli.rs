@@ -102,6 +102,20 @@ pub struct SynthArgs {
     /// Add small rigid head motion.
     #[arg(long)]
     pub head_motion: bool,
+    /// Face markers: full (109-marker face) or sparse (41 face markers).
+    #[arg(long, default_value = "full")]
+    pub markers: replay::synth::MarkerSet,
+    /// Marker names: descriptive (MouthCornerL), snake (mouth_01) or numbered (M001).
+    #[arg(long, default_value = "descriptive")]
+    pub names: replay::synth::Naming,
+    /// Rigid head markers: band (4 head-band markers), vicon (LFHD RFHD LBHD RBHD) or none (and
+    /// a nose that moves with the face).
+    #[arg(long, default_value = "band")]
+    pub rigid: replay::synth::RigidMarkers,
+    /// Move each face marker at random by up to this many mm (and the face's width and height
+    /// by up to 8 %), so the face is not the default one.
+    #[arg(long, default_value_t = 0.0)]
+    pub placement_jitter: f64,
     /// File format of the takes: c3d, trc or csv.
     #[arg(long, default_value = "c3d")]
     pub format: String,
@@ -164,10 +178,18 @@ pub struct TrainArgs {
     /// Glitch speed limit: auto, off, or mm/s. Faster moves are treated as missing.
     #[arg(long, default_value = "auto")]
     pub max_speed: String,
-    /// Rigid head markers: auto, none, or comma-separated labels (default: the regions file's
-    /// head_reference, else auto).
+    /// Rigid head markers: auto, none, or comma-separated labels or globs (default: the
+    /// regions file's head_reference, else auto: common head-marker names, then the markers
+    /// the capture shows to be rigid).
     #[arg(long)]
     pub head_reference: Option<String>,
+    /// Case-insensitive name patterns of head markers tried by auto before the geometry.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "LFHD,RFHD,LBHD,RBHD,head*,hat*,helmet*"
+    )]
+    pub head_patterns: Vec<String>,
     /// Regions file (default: regions.toml beside the manifest, if any).
     #[arg(long)]
     pub regions: Option<PathBuf>,

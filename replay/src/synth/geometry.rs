@@ -75,12 +75,19 @@ impl Region {
 /// One marker: label, region and rest position (mm).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Marker {
-    /// Label, e.g. `MouthCornerL`.
+    /// Label written to the takes, e.g. `MouthCornerL` (or `mouth_01`, `M042` in other
+    /// [`Naming`](super::layout::Naming)s).
     pub label: String,
+    /// The marker's anatomical name on the canonical face (`MouthCornerL`): what the source
+    /// fields key on, whatever the label says.
+    pub kind: String,
     /// Region the marker belongs to.
     pub region: Region,
-    /// Rest (neutral) position, mm.
+    /// Rest (neutral) position, mm, as placed on this face.
     pub rest: [f64; 3],
+    /// Position on the canonical face, mm: the source fields are evaluated here, so a face
+    /// with moved markers still moves like a face.
+    pub canonical: [f64; 3],
 }
 
 /// The marker set of the synthetic face.
@@ -121,16 +128,18 @@ impl FaceGeometry {
     }
 
     /// Region name -> labels of the markers in it.
+    /// Regions without markers (the head reference of a face with no rigid markers) are left
+    /// out.
     pub fn region_labels(&self) -> BTreeMap<String, Vec<String>> {
         Region::ALL
             .iter()
-            .map(|r| {
-                let labels = self
+            .filter_map(|r| {
+                let labels: Vec<String> = self
                     .indices(*r)
                     .into_iter()
                     .map(|i| self.markers[i].label.clone())
                     .collect();
-                (r.name().to_string(), labels)
+                (!labels.is_empty()).then(|| (r.name().to_string(), labels))
             })
             .collect()
     }
@@ -161,8 +170,10 @@ impl Builder {
     fn at(&mut self, label: &str, region: Region, rest: [f64; 3]) {
         self.markers.push(Marker {
             label: label.to_string(),
+            kind: label.to_string(),
             region,
             rest,
+            canonical: rest,
         });
     }
 
@@ -180,6 +191,18 @@ fn surface_z(x: f64, y: f64) -> f64 {
     let (y0, z0) = (-20.0, -80.0);
     let s = 1.0 - (x / a).powi(2) - ((y - y0) / b).powi(2);
     z0 + c * s.max(0.0).sqrt()
+}
+
+/// A Vicon-style head band: front and back markers at the temples and the back of the head,
+/// named as Vicon's Plug-in Gait names them.
+pub(crate) fn vicon_head_band() -> FaceGeometry {
+    let mut b = Builder::default();
+    let r = Region::HeadReference;
+    b.at("LFHD", r, [62.0, 70.0, -45.0]);
+    b.at("RFHD", r, [-62.0, 70.0, -45.0]);
+    b.at("LBHD", r, [58.0, 60.0, -175.0]);
+    b.at("RBHD", r, [-58.0, 60.0, -175.0]);
+    FaceGeometry { markers: b.markers }
 }
 
 fn head_reference(b: &mut Builder) {

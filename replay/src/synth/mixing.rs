@@ -64,8 +64,10 @@ pub fn source_infos() -> Vec<SourceInfo> {
 }
 
 /// The mixing matrix, channels x sources, row-major (`m[(marker * 3 + axis) * SOURCE_COUNT +
-/// source]`), mm per source unit.
-pub fn mixing_matrix(face: &FaceGeometry) -> Vec<f64> {
+/// source]`), mm per source unit. With `soft_nose` the nose bridge, sides and tip move a
+/// little with the brows, the upper lip and the emotion, as a real nose does, so that no marker
+/// of the face is rigid.
+pub fn mixing_matrix(face: &FaceGeometry, soft_nose: bool) -> Vec<f64> {
     let fields: [fn(&Marker) -> [f64; 3]; HEAD] = [
         jaw_open,
         lip_round,
@@ -82,6 +84,9 @@ pub fn mixing_matrix(face: &FaceGeometry) -> Vec<f64> {
             for (s, field) in fields.iter().enumerate() {
                 cols[s] = field(marker);
             }
+            if soft_nose {
+                add_soft_nose(marker, &mut cols);
+            }
         }
         cols[HEAD..].copy_from_slice(&head_columns(marker.rest));
         for (s, col) in cols.iter().enumerate() {
@@ -91,6 +96,28 @@ pub fn mixing_matrix(face: &FaceGeometry) -> Vec<f64> {
         }
     }
     m
+}
+
+/// The small nose motions of a face without rigid markers (mm per source unit): the bridge
+/// wrinkles with the brows and the emotion (procerus), the tip and sides follow the upper lip.
+fn add_soft_nose(m: &Marker, cols: &mut [[f64; 3]; SOURCE_COUNT]) {
+    let add = |col: &mut [f64; 3], v: [f64; 3]| {
+        for (c, d) in col.iter_mut().zip(v) {
+            *c += d;
+        }
+    };
+    match m.kind.as_str() {
+        "NoseBridge" => {
+            add(&mut cols[BROW_RAISE], [0.0, 0.6, 0.0]);
+            add(&mut cols[EMOTION], [0.0, 0.5, 0.1]);
+        }
+        "NoseTip" => add(&mut cols[3], [0.0, 0.6, 0.3]),
+        k if k.starts_with("NoseSide") => {
+            add(&mut cols[3], [0.0, 0.5, 0.1]);
+            add(&mut cols[EMOTION], [0.3 * side(m), 0.4, 0.0]);
+        }
+        _ => {}
+    }
 }
 
 /// d/d(pose) of the rigid motion at a rest point: rotations about x, y, z through the pivot,
@@ -112,7 +139,7 @@ fn head_columns(p: [f64; 3]) -> [[f64; 3]; 6] {
 }
 
 fn label_starts(m: &Marker, stem: &str) -> bool {
-    m.label.starts_with(stem)
+    m.kind.starts_with(stem)
 }
 
 /// Smooth step from 0 at `a` to 1 at `b`.
@@ -124,7 +151,7 @@ fn smoothstep(a: f64, b: f64, x: f64) -> f64 {
 /// Smooth falloff around the nearer of the two mirrored centres (±cx, cy): a compact Wendland
 /// C2 kernel reaching zero at 3 x `radius`, so a field never leaks onto distant regions.
 fn bump(m: &Marker, cx: f64, cy: f64, radius: f64) -> f64 {
-    let (x, y) = (m.rest[0].abs(), m.rest[1]);
+    let (x, y) = (m.canonical[0].abs(), m.canonical[1]);
     let q = ((x - cx).powi(2) + (y - cy).powi(2)).sqrt() / (3.0 * radius);
     if q >= 1.0 {
         0.0
@@ -134,12 +161,12 @@ fn bump(m: &Marker, cx: f64, cy: f64, radius: f64) -> f64 {
 }
 
 fn side(m: &Marker) -> f64 {
-    m.rest[0].signum()
+    m.canonical[0].signum()
 }
 
 /// Weight of the mouth-corner motion carried by a lip marker (1 at the corner, 0 mid-lip).
 fn corner_share(m: &Marker) -> f64 {
-    (m.rest[0].abs() / MOUTH_HALF_WIDTH).powi(2)
+    (m.canonical[0].abs() / MOUTH_HALF_WIDTH).powi(2)
 }
 
 fn jaw_open(m: &Marker) -> [f64; 3] {
@@ -148,19 +175,19 @@ fn jaw_open(m: &Marker) -> [f64; 3] {
         Region::Mouth if label_starts(m, "LowerLip") => 0.95,
         Region::Mouth if label_starts(m, "MouthCorner") => 0.45,
         Region::Mouth => 0.1,
-        Region::Cheeks => smoothstep(-30.0, -72.0, m.rest[1]),
+        Region::Cheeks => smoothstep(-30.0, -72.0, m.canonical[1]),
         _ => 0.0,
     };
-    let (ry, rz) = (m.rest[1] - JAW_HINGE[0], m.rest[2] - JAW_HINGE[1]);
+    let (ry, rz) = (m.canonical[1] - JAW_HINGE[0], m.canonical[2] - JAW_HINGE[1]);
     [0.0, -rz * JAW_RAD * w, ry * JAW_RAD * w]
 }
 
 fn lip_round(m: &Marker) -> [f64; 3] {
     if m.region == Region::Mouth {
         // Pucker: lips gather towards the mouth centre and push forward.
-        let dy = m.rest[1] - MOUTH_Y;
+        let dy = m.canonical[1] - MOUTH_Y;
         return [
-            -0.2 * m.rest[0],
+            -0.2 * m.canonical[0],
             -0.15 * dy,
             3.0 + 2.0 * (1.0 - corner_share(m)),
         ];
@@ -172,15 +199,15 @@ fn lip_round(m: &Marker) -> [f64; 3] {
 fn lip_spread(m: &Marker) -> [f64; 3] {
     if m.region == Region::Mouth {
         // Stretch sideways, thin and flatten the lips against the teeth.
-        let dy = m.rest[1] - MOUTH_Y;
-        return [0.2 * m.rest[0], -0.08 * dy, -1.5];
+        let dy = m.canonical[1] - MOUTH_Y;
+        return [0.2 * m.canonical[0], -0.08 * dy, -1.5];
     }
     let g = bump(m, MOUTH_HALF_WIDTH + 6.0, MOUTH_Y, 14.0);
     [2.0 * side(m) * g, 0.0, -0.5 * g]
 }
 
 fn upper_lip_raise(m: &Marker) -> [f64; 3] {
-    let x = m.rest[0].abs();
+    let x = m.canonical[0].abs();
     match m.region {
         Region::Mouth if label_starts(m, "UpperLip") => {
             let w = (-((x - 8.0) / 10.0).powi(2)).exp();
@@ -199,7 +226,7 @@ fn upper_lip_raise(m: &Marker) -> [f64; 3] {
 /// Positive = smile (happy), negative = frown (frustrated): mouth corners, cheeks, lids and
 /// brows all move, so the emotion is not confined to one region.
 fn emotion(m: &Marker) -> [f64; 3] {
-    let x = m.rest[0].abs();
+    let x = m.canonical[0].abs();
     let inner = smoothstep(54.0, 14.0, x);
     match m.region {
         Region::Mouth => {
@@ -216,17 +243,17 @@ fn emotion(m: &Marker) -> [f64; 3] {
         Region::Eyelids => [0.0, -0.8, 0.0],
         // Happy lifts and separates the inner brows; frustrated lowers and knits them.
         Region::Eyebrows => [1.5 * side(m) * inner, 1.0 + 1.5 * inner, 0.3],
-        Region::Forehead if m.rest[1] < 45.0 => [0.0, 0.8 * smoothstep(50.0, 10.0, x), 0.0],
+        Region::Forehead if m.canonical[1] < 45.0 => [0.0, 0.8 * smoothstep(50.0, 10.0, x), 0.0],
         _ => [0.0; 3],
     }
 }
 
 /// Frontalis raise: whole brows up (the middle most), forehead follows, upper lids lift a bit.
 fn brow_raise(m: &Marker) -> [f64; 3] {
-    let x = m.rest[0].abs();
+    let x = m.canonical[0].abs();
     match m.region {
         Region::Eyebrows => [0.0, 4.0 + 1.5 * bump(m, 30.0, 22.0, 12.0), 0.5],
-        Region::Forehead if m.rest[1] < 45.0 => [0.0, 3.0, 0.2],
+        Region::Forehead if m.canonical[1] < 45.0 => [0.0, 3.0, 0.2],
         Region::Forehead => [0.0, 1.5, 0.0],
         Region::Eyelids if label_starts(m, "LidUpper") => [0.0, 1.0 - 0.01 * (x - 32.0).abs(), 0.0],
         _ => [0.0; 3],
@@ -235,7 +262,7 @@ fn brow_raise(m: &Marker) -> [f64; 3] {
 
 /// Upper lids close over the eye (most at the centre), lower lids rise slightly.
 fn blink(m: &Marker) -> [f64; 3] {
-    match m.label.as_str() {
+    match m.kind.as_str() {
         l if l.starts_with("LidUpperIn") || l.starts_with("LidUpperOut") => [0.0, -6.5, -1.5],
         l if l.starts_with("LidUpper") => [0.0, -9.0, -2.0],
         l if l.starts_with("LidLower") => [0.0, 1.5, 0.0],
@@ -257,7 +284,7 @@ mod tests {
     #[test]
     fn each_field_stays_in_its_regions() {
         let face = FaceGeometry::standard();
-        let m = mixing_matrix(&face);
+        let m = mixing_matrix(&face, false);
         let upper = [Region::Eyebrows, Region::Eyelids, Region::Forehead];
         for (i, mk) in face.markers.iter().enumerate() {
             for s in 0..SPEECH_SOURCE_NAMES.len() {

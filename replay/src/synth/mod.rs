@@ -20,6 +20,7 @@
 //! Same parameters, same bits: every random draw comes from its own seeded ChaCha8 stream.
 
 pub mod geometry;
+pub mod layout;
 pub mod mixing;
 pub mod render;
 mod seeds;
@@ -32,6 +33,7 @@ pub mod warp;
 use std::path::PathBuf;
 
 pub use geometry::{FaceGeometry, Region};
+pub use layout::{Layout, MarkerSet, Naming, RigidMarkers};
 pub use mixing::{SourceInfo, SOURCE_COUNT};
 pub use render::{RenderedTake, TakeSpec, NOISE_STD_MM};
 pub use session_io::{generate_session, write_session, SessionSummary, SynthSession};
@@ -134,6 +136,8 @@ pub struct SynthParams {
     pub rate_hz: f64,
     /// Whether to add small rigid head motion.
     pub head_motion: bool,
+    /// The face layout: markers, names, rigid markers, placement.
+    pub layout: Layout,
 }
 
 impl Default for SynthParams {
@@ -144,6 +148,7 @@ impl Default for SynthParams {
             emotions: DEFAULT_EMOTIONS.iter().map(|s| s.to_string()).collect(),
             rate_hz: DEFAULT_RATE_HZ,
             head_motion: false,
+            layout: Layout::default(),
         }
     }
 }
@@ -196,13 +201,13 @@ impl Synth {
     /// [`SynthParams::validate`] failures.
     pub fn new(params: SynthParams) -> Result<Synth, SynthError> {
         params.validate()?;
-        let face = FaceGeometry::standard();
+        let face = params.layout.face(params.seed);
         let sentences = (0..params.sentences)
             .map(|i| Sentence::generate(params.seed, i, params.sentences))
             .collect();
         Ok(Synth {
             rest: face.rest_flat(),
-            mixing: mixing::mixing_matrix(&face),
+            mixing: mixing::mixing_matrix(&face, params.layout.soft_nose()),
             levels: sources::emotion_levels(&params.emotions),
             face,
             sentences,

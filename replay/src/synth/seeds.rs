@@ -25,6 +25,8 @@ pub(crate) enum Stream {
     Head = 7,
     /// Sensor noise.
     Noise = 8,
+    /// Marker placement of a jittered layout.
+    Layout = 9,
 }
 
 /// SplitMix64 finaliser: a cheap, well-mixed bijection on u64.

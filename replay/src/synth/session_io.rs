@@ -69,6 +69,7 @@ impl Synth {
             seed: self.params().seed,
             noise_std_mm: NOISE_STD_MM,
             head_motion: self.params().head_motion,
+            layout: self.params().layout.describe(),
             head_pivot: HEAD_PIVOT,
         }
     }
@@ -93,8 +94,14 @@ pub fn generate_session(params: &SynthParams, format: Format) -> Result<SynthSes
             .collect(),
         base_dir: PathBuf::new(),
     };
+    // The default face keeps its glob patterns; other layouts list their labels, since their
+    // names may say nothing about the region.
     let regions = Regions {
-        regions: FaceGeometry::region_patterns(),
+        regions: if params.layout.is_standard() {
+            FaceGeometry::region_patterns()
+        } else {
+            synth.face().region_labels()
+        },
     };
     let mixing = synth.mixing_truth();
     let (takes, truths) = rendered.into_iter().map(|r| (r.take, r.truth)).unzip();

@@ -55,6 +55,9 @@ pub struct MixingTruth {
     pub noise_std_mm: f64,
     /// Whether rigid head motion was rendered.
     pub head_motion: bool,
+    /// The face layout, described (empty in truth written before layouts existed).
+    #[serde(default)]
+    pub layout: String,
     /// Pivot of the head rotations, mm.
     pub head_pivot: [f64; 3],
 }
