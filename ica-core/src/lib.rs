@@ -8,6 +8,7 @@ pub mod fit;
 pub mod interpret;
 pub mod model;
 pub mod project;
+pub mod quality;
 pub mod report;
 pub mod stabilise;
 pub mod whiten;

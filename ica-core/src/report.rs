@@ -83,6 +83,12 @@ pub struct TrainReport {
     pub restarts: Vec<RestartReport>,
     /// Index into `restarts` of the solution kept.
     pub best_restart: usize,
+    /// Stability of each kept component across the restarts (component order): the mean over
+    /// the other restarts of its best-match |correlation| with their components, in the manner
+    /// of ICASSO. 1 means every restart found it; empty with a single restart or in reports
+    /// written before this field existed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stability: Vec<f64>,
 }
 
 impl TrainReport {
@@ -103,6 +109,7 @@ impl TrainReport {
             max_iter: 100,
             restarts: vec![],
             best_restart: 0,
+            stability: vec![],
         }
     }
 }

@@ -117,6 +117,10 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
         max_missing: 0.5,
         max_speed: "auto".into(),
         head_reference: None,
+        head_patterns: crate::training::DEFAULT_HEAD_PATTERNS
+            .iter()
+            .map(|p| p.to_string())
+            .collect(),
         regions: session.regions.clone(),
         no_bounds: false,
     })?;

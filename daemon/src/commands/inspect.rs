@@ -1,6 +1,7 @@
 //! `emoshift inspect model.json [--json]`.
 
 use anyhow::Result;
+use ica_core::quality::ModelQuality;
 
 use crate::cli::InspectArgs;
 
@@ -44,6 +45,70 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     for (k, role) in model.roles().iter().enumerate() {
         let norm = model.mixing().column(k).norm();
         crate::out!("  c{k}: {role:?} (mixing norm {norm:.3} mm)");
+    }
+    if model.quality().is_empty() {
+        crate::out!("quality:    not recorded (trained before quality reports)");
+        return Ok(());
+    }
+    print_quality(model.quality())
+}
+
+/// Prints a model's quality report: the head decision, stability, residuals and warnings.
+pub(crate) fn print_quality(q: &ModelQuality) -> Result<()> {
+    if let Some(h) = &q.head {
+        crate::out!("head:       {}: {}", h.source, h.verdict);
+        let numbers: Vec<String> = [
+            ("noise", h.noise_mm, 3),
+            ("deformation", h.deformation_mm, 2),
+            ("head motion", h.motion_mm, 2),
+            ("pose error", h.pose_error_mm, 2),
+        ]
+        .iter()
+        .filter_map(|(name, v, digits)| v.map(|v| format!("{name} {v:.digits$} mm")))
+        .chain(h.leakage.map(|l| format!("leakage {:.0} %", 100.0 * l)))
+        .collect();
+        if !numbers.is_empty() {
+            crate::out!("  {}", numbers.join(", "));
+        }
+        if !h.residual_mm.is_empty() {
+            let per: Vec<String> = h
+                .residual_mm
+                .iter()
+                .map(|(l, r)| format!("{l} {r:.2}"))
+                .collect();
+            crate::out!("  reference residual (mm RMS): {}", per.join(", "));
+        }
+    }
+    if !q.stability.is_empty() {
+        let s: Vec<String> = q
+            .stability
+            .iter()
+            .enumerate()
+            .map(|(i, s)| format!("c{i} {s:.2}"))
+            .collect();
+        crate::out!(
+            "stability:  {} (best-match |corr| across restarts)",
+            s.join(", ")
+        );
+    }
+    if !q.residual_by_region_mm.is_empty() {
+        let r: Vec<String> = q
+            .residual_by_region_mm
+            .iter()
+            .map(|(name, v)| format!("{name} {v:.2}"))
+            .collect();
+        crate::out!("residual:   {} (mm RMS per marker)", r.join(", "));
+    }
+    if let (Some(mm), Some(marker)) = (q.slow_residual_mm, &q.slow_residual_marker) {
+        crate::out!("slow residual: {mm:.2} mm RMS, peak at {marker}");
+    }
+    if q.warnings.is_empty() {
+        crate::out!("warnings:   none");
+    } else {
+        crate::out!("warnings:");
+        for w in &q.warnings {
+            crate::out!("  - {}", w.message);
+        }
     }
     Ok(())
 }

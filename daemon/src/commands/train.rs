@@ -16,26 +16,31 @@ use replay::session::Regions;
 /// The regions file's region naming the rigid head markers.
 pub const HEAD_REGION: &str = "head_reference";
 
-fn head_choice(args: &TrainArgs) -> Result<HeadChoice> {
-    if let Some(text) = &args.head_reference {
-        return Ok(match text.as_str() {
-            "none" => HeadChoice::None,
-            "auto" => HeadChoice::Auto,
-            list => HeadChoice::Labels(list.split(',').map(|s| s.trim().to_string()).collect()),
-        });
-    }
-    // The regions file's head reference, when there is one (beside the manifest by default).
-    let regions_path = args.regions.clone().or_else(|| {
+/// The regions file: `--regions`, else `regions.toml` beside the manifest if there is one.
+fn regions(args: &TrainArgs) -> Result<Option<Regions>> {
+    let path = args.regions.clone().or_else(|| {
         let p = args.manifest.as_ref()?.parent()?.join("regions.toml");
         p.exists().then_some(p)
     });
-    if let Some(path) = regions_path {
-        let regions = Regions::load(&path).with_context(|| format!("{}", path.display()))?;
-        if let Some(patterns) = regions.regions.get(HEAD_REGION) {
-            return Ok(HeadChoice::Labels(patterns.clone()));
-        }
+    path.map(|path| Regions::load(&path).with_context(|| format!("{}", path.display())))
+        .transpose()
+}
+
+fn head_choice(args: &TrainArgs, regions: Option<&Regions>) -> HeadChoice {
+    let auto = HeadChoice::Auto {
+        patterns: args.head_patterns.clone(),
+    };
+    if let Some(text) = &args.head_reference {
+        return match text.as_str() {
+            "none" => HeadChoice::None,
+            "auto" => auto,
+            list => HeadChoice::Labels(list.split(',').map(|s| s.trim().to_string()).collect()),
+        };
     }
-    Ok(HeadChoice::Auto)
+    match regions.and_then(|r| r.regions.get(HEAD_REGION)) {
+        Some(patterns) => HeadChoice::Labels(patterns.clone()),
+        None => auto,
+    }
 }
 
 fn speed_limit(text: &str) -> Result<SpeedLimit> {
@@ -84,11 +89,12 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     let takes = offline::load_inputs(args.manifest.as_deref(), &args.files)?;
     bar.set_length(takes.len() as u64);
     bar.set_position(takes.len() as u64);
+    let regions = regions(args)?;
     let options = PrepOptions {
         rate_hz: args.rate,
         max_missing_share: args.max_missing,
         speed: speed_limit(&args.max_speed)?,
-        head: head_choice(args)?,
+        head: head_choice(args, regions.as_ref()),
         bounds: !args.no_bounds,
     };
     let data = training::prepare(&takes, &options)?;
@@ -111,6 +117,7 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     )
     .context("the fitted model failed validation")?;
     model.set_capture(data.capture.clone())?;
+    model.set_quality(training::quality::assess(&model, &data, regions.as_ref()));
     let file = std::fs::File::create(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     model
@@ -118,6 +125,7 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     print_preparation(&data)?;
     print_summary(&model, takes.len(), started.elapsed().as_secs_f64())?;
+    super::inspect::print_quality(model.quality())?;
     crate::out!("model: {}", args.out.display());
     Ok(())
 }
@@ -163,17 +171,16 @@ fn print_preparation(data: &PreparedData) -> Result<()> {
         "glitches: {} samples {limit}{bounds} treated as missing{detail}",
         data.glitches
     );
-    match data.residual_summary() {
-        Some((median, p95)) => crate::out!(
+    crate::out!(
+        "head reference ({}): {}",
+        data.head.source,
+        data.head.verdict
+    );
+    if let Some((median, p95)) = data.residual_summary() {
+        crate::out!(
             "head stabilised on {}: residual median {median:.2} mm, p95 {p95:.2} mm",
             data.reference.join(", ")
-        ),
-        None => match data.head_motion_mm {
-            Some(motion) => crate::out!(
-                "no head stabilisation: the reference markers move {motion:.2} mm RMS, too little to gain from it"
-            ),
-            None => crate::out!("no head stabilisation"),
-        },
+        );
     }
     Ok(())
 }

@@ -78,6 +78,8 @@ pub(crate) struct IcaRun {
     pub sources: DMatrix<f64>,
     pub restarts: Vec<RestartReport>,
     pub best: usize,
+    /// Every restart's rotation, in run order (the best one before refinement).
+    pub restart_w: Vec<DMatrix<f64>>,
 }
 
 /// Restarts explore about this many frames when the take is long enough (see [`run`]).
@@ -127,6 +129,7 @@ pub(crate) fn run(z: &DMatrix<f64>, s: Settings) -> IcaRun {
         sources: ws.gy,
         restarts: explored.restarts,
         best: explored.best,
+        restart_w: explored.restart_w,
     }
 }
 
@@ -164,6 +167,7 @@ fn explore(z: &DMatrix<f64>, s: Settings) -> IcaRun {
     let mut ws = symmetric::Workspace::new(m, frames);
     let mut best: Option<(usize, f64, DMatrix<f64>, DMatrix<f64>)> = None;
     let mut reports = Vec::with_capacity(s.restarts);
+    let mut restart_w = Vec::with_capacity(s.restarts);
     for k in 0..s.restarts {
         let seed = restart_seed(s.seed, k);
         let out = solve(z, random_start(m, seed), s, &mut ws);
@@ -184,6 +188,7 @@ fn explore(z: &DMatrix<f64>, s: Settings) -> IcaRun {
                 (conv && !b_conv) || (conv == b_conv && negentropy > *score)
             }
         };
+        restart_w.push(out.w.clone());
         if better {
             best = Some((k, negentropy, out.w, ws.gy.clone()));
         }
@@ -194,7 +199,44 @@ fn explore(z: &DMatrix<f64>, s: Settings) -> IcaRun {
         sources,
         restarts: reports,
         best,
+        restart_w,
     }
+}
+
+/// Stability of each row of `kept` across the other restarts, in the manner of ICASSO: for
+/// each other restart, the best-matching |correlation| of the component with any of that
+/// restart's components, averaged over the restarts. On whitened data the correlation of
+/// `w_i·z` and `v_j·z` is `w_i·v_j` (unit rows), so no data pass is needed. Empty with a single
+/// restart.
+pub(crate) fn stability(kept: &DMatrix<f64>, restarts: &[DMatrix<f64>], best: usize) -> Vec<f64> {
+    let others: Vec<&DMatrix<f64>> = restarts
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| *k != best)
+        .map(|(_, w)| w)
+        .collect();
+    if others.is_empty() {
+        return Vec::new();
+    }
+    let unit = |w: &DMatrix<f64>| {
+        let mut w = w.clone();
+        for mut row in w.row_iter_mut() {
+            let n = row.norm();
+            if n > 0.0 {
+                row /= n;
+            }
+        }
+        w
+    };
+    let kept = unit(kept);
+    let mut sum = vec![0.0; kept.nrows()];
+    for w in &others {
+        let c = &kept * unit(w).transpose();
+        for (i, row) in c.row_iter().enumerate() {
+            sum[i] += row.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        }
+    }
+    sum.iter().map(|s| s / others.len() as f64).collect()
 }
 
 /// A standard-normal `m x m` start drawn from the restart's seed (rows are orthonormalised by the

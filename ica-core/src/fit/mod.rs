@@ -91,9 +91,15 @@ impl FastIcaParams {
                 restarts: self.restarts,
             },
         );
+        let stability = fastica::stability(&run.w, &run.restart_w, run.best);
         let (mixing, unmixing, sources) = assemble(&wh, &run.w, run.sources, data.channels());
-        let (mixing, unmixing, sources, component_variance) =
+        let (mixing, unmixing, sources, component_variance, order) =
             canonicalise(mixing, unmixing, sources);
+        let stability = if stability.is_empty() {
+            stability
+        } else {
+            order.iter().map(|&i| stability[i]).collect()
+        };
         let report = TrainReport {
             frames_total: wh.frames_total,
             frames_used: wh.used_frames.len(),
@@ -108,6 +114,7 @@ impl FastIcaParams {
             max_iter: self.max_iter,
             restarts: run.restarts,
             best_restart: run.best,
+            stability,
         };
         Ok(FitOutput {
             mean: wh.mean,
@@ -148,12 +155,18 @@ fn assemble(
     (mixing, unmixing, sources)
 }
 
+/// Mixing, unmixing and sources in canonical order and sign, each component's variance, and
+/// the original index of each canonical component.
+type Canonical = (
+    DMatrix<f64>,
+    DMatrix<f64>,
+    DMatrix<f64>,
+    Vec<f64>,
+    Vec<usize>,
+);
+
 /// Applies the sign and order convention (see the module docs).
-fn canonicalise(
-    mixing: DMatrix<f64>,
-    unmixing: DMatrix<f64>,
-    sources: DMatrix<f64>,
-) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>, Vec<f64>) {
+fn canonicalise(mixing: DMatrix<f64>, unmixing: DMatrix<f64>, sources: DMatrix<f64>) -> Canonical {
     let m = mixing.ncols();
     let variance: Vec<f64> = mixing.column_iter().map(|c| c.norm_squared()).collect();
     let mut order: Vec<usize> = (0..m).collect();
@@ -184,7 +197,7 @@ fn canonicalise(
     });
     let src = DMatrix::from_fn(frames, m, |r, c| sources[(r, order[c])] * signs[order[c]]);
     let variance = order.iter().map(|&i| variance[i]).collect();
-    (mix, unmix, src, variance)
+    (mix, unmix, src, variance, order)
 }
 
 /// Sample skewness `E (y - ȳ)^3 / σ^3` (0 for a constant or empty series).

@@ -2,7 +2,8 @@
 //!
 //! Layout (version 1), in this order: `format_version`, `labels`, `rate_hz`, `mean`
 //! (channels), `mixing` (channels rows of components), `unmixing` (components rows of
-//! channels), `roles`, `emotion` (`component`, `levels`), `report`.
+//! channels), `roles`, `emotion` (`component`, `levels`), `report`, and the optional `capture`
+//! (frame preparation) and `quality` (the model's own quality report).
 //!
 //! Compatibility policy:
 //! - Fields added later are optional with `#[serde(default)]` (as `roles` and `emotion` are
@@ -22,6 +23,7 @@ use super::{
     check_finite, check_parts, check_pseudo_inverse, CaptureSettings, EmotionLevels, IcaModel,
     ModelError, Role,
 };
+use crate::quality::ModelQuality;
 use crate::report::TrainReport;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -46,6 +48,9 @@ struct ModelFile {
     // Omitted when default, so models without head stabilisation keep their version-1 bytes.
     #[serde(default, skip_serializing_if = "CaptureSettings::is_default")]
     capture: CaptureSettings,
+    // Optional: files written before the quality report load with an empty one.
+    #[serde(default, skip_serializing_if = "ModelQuality::is_empty")]
+    quality: ModelQuality,
 }
 
 /// Only the version, read first so that a future layout fails with
@@ -72,6 +77,7 @@ impl IcaModel {
             emotion: self.emotion.clone(),
             report: self.report.clone(),
             capture: self.capture.clone(),
+            quality: self.quality.clone(),
         };
         let mut ser = serde_json::Serializer::with_formatter(writer, RowsFormatter::default());
         file.serialize(&mut ser).map_err(ModelError::Write)?;
@@ -168,6 +174,7 @@ fn from_file(file: ModelFile) -> Result<IcaModel, ModelError> {
         emotion: file.emotion,
         report: file.report,
         capture: file.capture,
+        quality: file.quality,
     })
 }
 

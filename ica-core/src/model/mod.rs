@@ -17,6 +17,7 @@ mod take;
 pub use error::ModelError;
 pub use file::FORMAT_VERSION;
 
+use crate::quality::ModelQuality;
 use crate::report::TrainReport;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -73,6 +74,7 @@ pub struct IcaModel {
     emotion: EmotionLevels,
     report: TrainReport,
     capture: CaptureSettings,
+    quality: ModelQuality,
 }
 
 /// How frames are prepared before projection, stored so that `project`, `edit` and the daemon
@@ -138,6 +140,7 @@ impl IcaModel {
             emotion: EmotionLevels::default(),
             report,
             capture: CaptureSettings::default(),
+            quality: ModelQuality::default(),
         })
     }
 
@@ -215,6 +218,16 @@ impl IcaModel {
     /// What training did.
     pub fn report(&self) -> &TrainReport {
         &self.report
+    }
+
+    /// The quality report (empty for models trained before it existed).
+    pub fn quality(&self) -> &ModelQuality {
+        &self.quality
+    }
+
+    /// Sets the quality report.
+    pub fn set_quality(&mut self, quality: ModelQuality) {
+        self.quality = quality;
     }
 
     /// Index of the marker with this label.

@@ -16,6 +16,7 @@ fn report(channels: usize, components: usize) -> TrainReport {
         max_iter: 200,
         restarts: vec![],
         best_restart: 0,
+        stability: vec![],
     }
 }
 

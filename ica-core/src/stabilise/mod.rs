@@ -2,7 +2,8 @@
 //! it back after editing.
 //!
 //! A set of rigid reference markers (forehead, nose bridge, head band...) is chosen by label or
-//! automatically ([`choose_reference`]: the set whose pairwise distances vary least). From the
+//! found in the capture ([`search`]: markers rigid among themselves that move as a head, not as
+//! a part of the face; [`GroupAssessment`] says how well). From the
 //! training frames a reference shape, the *template*, is built by generalised Procrustes
 //! averaging. Each frame's pose is then the rigid transform (Kabsch) that best maps the template
 //! onto the reference markers present in that frame: `world = R · head + t`.
@@ -13,6 +14,14 @@
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
+
+mod assess;
+pub mod search;
+
+pub use assess::GroupAssessment;
+pub use search::{
+    assess_named, choose, search_reference, Choice, MarkerFrames, ReferenceSearch, SearchParams,
+};
 
 /// Why stabilisation could not be set up.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -79,7 +88,7 @@ pub struct PoseEstimate {
 
 /// Kabsch fit of `template` points onto `observed` points (pairs where `present`), minimising the
 /// squared distances. Returns `None` with fewer than three pairs or a degenerate configuration.
-fn kabsch<'a>(
+pub(crate) fn kabsch<'a>(
     pairs: impl Iterator<Item = (&'a [f64; 3], Vector3<f64>)> + Clone,
 ) -> Option<(Pose, usize)> {
     let mut count = 0usize;
@@ -119,7 +128,7 @@ fn kabsch<'a>(
     ))
 }
 
-fn point(frame: &[f32], marker: usize) -> Vector3<f64> {
+pub(crate) fn point(frame: &[f32], marker: usize) -> Vector3<f64> {
     let i = marker * 3;
     Vector3::new(frame[i] as f64, frame[i + 1] as f64, frame[i + 2] as f64)
 }
@@ -256,7 +265,7 @@ impl Stabiliser {
     }
 }
 
-fn centre(points: &mut [[f64; 3]]) {
+pub(crate) fn centre(points: &mut [[f64; 3]]) {
     let n = points.len().max(1) as f64;
     let mut mean = [0.0; 3];
     for p in points.iter() {
@@ -299,79 +308,6 @@ pub fn to_world_into(pose: &Pose, head: &[f32], world: &mut [f32]) {
     }
 }
 
-/// Chooses `count` rigid reference markers automatically: the set whose pairwise distances vary
-/// least over the frames (greedy: the most stable pair, then repeatedly the marker whose mean
-/// distance standard deviation to the chosen set is smallest). Markers missing in more than half
-/// of the frames are never chosen. Every `stride`-th frame is used, to bound the cost.
-pub fn choose_reference(
-    frames: &[f32],
-    missing: &[bool],
-    n_markers: usize,
-    count: usize,
-    stride: usize,
-) -> Vec<usize> {
-    let n_frames = missing.len() / n_markers.max(1);
-    let stride = stride.max(1);
-    let present = |f: usize, m: usize| !missing[f * n_markers + m];
-    let usable: Vec<usize> = (0..n_markers)
-        .filter(|&m| (0..n_frames).filter(|&f| present(f, m)).count() * 2 > n_frames)
-        .collect();
-    let mut spread = vec![f64::INFINITY; n_markers * n_markers];
-    for (ai, &a) in usable.iter().enumerate() {
-        for &b in &usable[ai + 1..] {
-            let (mut n, mut s, mut s2) = (0.0, 0.0, 0.0);
-            for f in (0..n_frames).step_by(stride) {
-                if present(f, a) && present(f, b) {
-                    let fr = &frames[f * n_markers * 3..(f + 1) * n_markers * 3];
-                    let d = (point(fr, a) - point(fr, b)).norm();
-                    n += 1.0;
-                    s += d;
-                    s2 += d * d;
-                }
-            }
-            if n >= 2.0 {
-                let var = (s2 - s * s / n) / (n - 1.0);
-                spread[a * n_markers + b] = var.max(0.0).sqrt();
-                spread[b * n_markers + a] = spread[a * n_markers + b];
-            }
-        }
-    }
-    let mut best_pair = None;
-    let mut best = f64::INFINITY;
-    for (ai, &a) in usable.iter().enumerate() {
-        for &b in &usable[ai + 1..] {
-            if spread[a * n_markers + b] < best {
-                best = spread[a * n_markers + b];
-                best_pair = Some((a, b));
-            }
-        }
-    }
-    let Some((a, b)) = best_pair else {
-        return Vec::new();
-    };
-    let mut chosen = vec![a, b];
-    while chosen.len() < count.min(usable.len()) {
-        let next = usable
-            .iter()
-            .filter(|m| !chosen.contains(m))
-            .map(|&m| {
-                let mean = chosen
-                    .iter()
-                    .map(|&c| spread[m * n_markers + c])
-                    .sum::<f64>()
-                    / chosen.len() as f64;
-                (m, mean)
-            })
-            .min_by(|x, y| x.1.total_cmp(&y.1));
-        match next {
-            Some((m, s)) if s.is_finite() => chosen.push(m),
-            _ => break,
-        }
-    }
-    chosen.sort_unstable();
-    chosen
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -406,16 +342,6 @@ mod tests {
             poses.push(pose);
         }
         (out, poses)
-    }
-
-    #[test]
-    fn automatic_choice_finds_the_rigid_markers() {
-        let (frames, _) = scene(200);
-        let missing = vec![false; 200 * 6];
-        assert_eq!(
-            choose_reference(&frames, &missing, 6, 4, 1),
-            vec![0, 1, 2, 3]
-        );
     }
 
     #[test]

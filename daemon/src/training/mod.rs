@@ -8,17 +8,25 @@
 //!    (a swap or a spike) is treated as missing. The limit is given, or derived from the data:
 //!    [`AUTO_SPEED_FACTOR`] × the 99.9th percentile of marker speeds, at least
 //!    [`MIN_AUTO_SPEED_MM_S`].
-//! 4. **Head**: rigid reference markers (given, from the regions file, or chosen automatically
-//!    as the set whose pairwise distances vary least) give each frame's pose; the face is
-//!    modelled in head coordinates. The stabilisation residual is reported.
+//! 4. **Head**: reference markers give each frame's pose and the face is modelled in head
+//!    coordinates; [`head`] decides which (named, a common head-marker name, or found in the
+//!    capture) and whether the head moves enough to be worth it. The stabilisation residual is
+//!    reported.
 //!
 //! The same [`FramePrep`] then runs in `project`, `edit` and the daemon, from the settings
 //! stored in the model.
 
+pub mod head;
+pub mod quality;
+
+use std::ops::Range;
+
 use anyhow::{bail, Result};
 use ica_core::model::{CaptureSettings, MarkerBounds};
-use ica_core::stabilise::{choose_reference, Stabiliser};
-use replay::session::Regions;
+use ica_core::quality::HeadReport;
+use ica_core::stabilise::{MarkerFrames, Stabiliser};
+
+pub use head::{HeadChoice, DEFAULT_HEAD_PATTERNS};
 
 use crate::frame::FramePrep;
 use crate::layout::LabelMap;
@@ -28,19 +36,6 @@ use crate::offline::{self, LoadedTake, ModelFrames};
 pub const AUTO_SPEED_FACTOR: f64 = 4.0;
 /// Floor of the automatic speed limit (mm/s): faces do not move faster than this in a frame.
 pub const MIN_AUTO_SPEED_MM_S: f64 = 500.0;
-/// Reference markers chosen automatically.
-pub const AUTO_REFERENCE_COUNT: usize = 4;
-
-/// How the head reference is chosen.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum HeadChoice {
-    /// No stabilisation.
-    None,
-    /// The markers whose pairwise distances vary least.
-    Auto,
-    /// These labels or glob patterns (as in a regions file).
-    Labels(Vec<String>),
-}
 
 /// The glitch speed limit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,10 +88,10 @@ pub struct PreparedData {
     pub residuals_mm: Vec<f64>,
     /// Reference marker labels (empty without stabilisation).
     pub reference: Vec<String>,
-    /// RMS motion (mm) of the candidate reference markers about their mean positions, when a
-    /// reference was chosen; below [`STILL_HEAD_FACTOR`] x the stabilisation residual the head
-    /// counts as still and is not stabilised.
-    pub head_motion_mm: Option<f64>,
+    /// How the head reference was decided, with its numbers (per-marker residuals filled in).
+    pub head: HeadReport,
+    /// Frame range of each take in `samples`.
+    pub takes: Vec<Range<usize>>,
 }
 
 impl PreparedData {
@@ -147,13 +142,28 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         })
         .collect::<Result<_>>()?;
     let n = labels.len();
-    // 1. The head: template from the raw frames (its Procrustes mean shrugs off rare glitches).
+    // 1. The head: decided on the raw frames, template from them (its Procrustes mean shrugs
+    //    off rare glitches).
     let raw_missing: Vec<bool> = frames
         .iter()
         .flat_map(|f| f.missing.iter().copied())
         .collect();
     let raw_xyz: Vec<f32> = frames.iter().flat_map(|f| f.xyz.iter().copied()).collect();
-    let mut reference = reference_markers(&options.head, &labels, &raw_xyz, &raw_missing)?;
+    let mut ranges = Vec::with_capacity(frames.len());
+    let mut start = 0;
+    for f in &frames {
+        ranges.push(start..start + f.frames());
+        start += f.frames();
+    }
+    let raw = MarkerFrames {
+        xyz: &raw_xyz,
+        missing: &raw_missing,
+        markers: n,
+        takes: &ranges,
+    };
+    let decision = head::decide(&options.head, &labels, &raw)?;
+    let reference = decision.markers;
+    let mut head_report = decision.report;
     let head = match reference.len() {
         0 => None,
         _ => Some(
@@ -167,19 +177,6 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         max_speed_mm_s: None,
         bounds: None,
     };
-    // A head that does not move gains nothing from stabilisation and would only add the pose
-    // estimate's noise (a rigid, correlated jitter) to every marker.
-    let mut head_motion_mm = None;
-    if capture.head.is_some() {
-        let (_, _, _, residuals) = run_prep(&frames, n, rate_hz, &capture)?;
-        let motion = reference_motion_mm(&raw_xyz, &raw_missing, n, &reference);
-        let residual = median(&residuals).unwrap_or(0.0);
-        head_motion_mm = Some(motion);
-        if motion < STILL_HEAD_FACTOR * residual {
-            capture.head = None;
-            reference.clear();
-        }
-    }
     // 2. Speeds and plausible regions measured in head coordinates, then applied.
     let (head_xyz, head_missing, _, _) = run_prep(&frames, n, rate_hz, &capture)?;
     capture.max_speed_mm_s = match options.speed {
@@ -193,8 +190,15 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
     let (samples, marker_missing, glitches, residuals_mm) =
         run_prep(&frames, n, rate_hz, &capture)?;
     let per_marker = glitches_per_marker(&frames, &marker_missing, n);
+    if let Some(h) = &capture.head {
+        head_report.residual_mm = reference_residuals(h, &samples, &marker_missing, n)
+            .into_iter()
+            .map(|(m, r)| (labels[m].clone(), r))
+            .collect();
+    }
     Ok(PreparedData {
-        head_motion_mm,
+        head: head_report,
+        takes: ranges,
         glitches_per_marker: per_marker,
         reference: reference.iter().map(|&i| labels[i].clone()).collect(),
         labels,
@@ -290,40 +294,6 @@ fn kept_markers(takes: &[replay::Take], max_share: f64) -> Result<KeptMarkers> {
     Ok((kept, excluded))
 }
 
-/// The head counts as still (and is not stabilised) when its reference markers move less than
-/// this multiple of the stabilisation residual.
-pub const STILL_HEAD_FACTOR: f64 = 3.0;
-
-/// RMS distance (mm) of the reference markers from their mean positions over all frames.
-fn reference_motion_mm(xyz: &[f32], missing: &[bool], n: usize, reference: &[usize]) -> f64 {
-    let frames = missing.len() / n.max(1);
-    let (mut sq, mut count) = (0.0, 0usize);
-    for &m in reference {
-        let present: Vec<usize> = (0..frames).filter(|&f| !missing[f * n + m]).collect();
-        if present.is_empty() {
-            continue;
-        }
-        let mut mean = [0.0f64; 3];
-        for &f in &present {
-            for (a, acc) in mean.iter_mut().enumerate() {
-                *acc += f64::from(xyz[(f * n + m) * 3 + a]) / present.len() as f64;
-            }
-        }
-        for &f in &present {
-            sq += (0..3)
-                .map(|a| (f64::from(xyz[(f * n + m) * 3 + a]) - mean[a]).powi(2))
-                .sum::<f64>();
-            count += 1;
-        }
-    }
-    (sq / count.max(1) as f64).sqrt()
-}
-
-fn median(values: &[f64]) -> Option<f64> {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    quantile(&mut v, 0.5)
-}
-
 /// Radius of a marker's plausible ball: this multiple of the 99th percentile of its distance
 /// from its median position…
 pub const BOUNDS_FACTOR: f64 = 2.0;
@@ -398,38 +368,45 @@ fn auto_speed(
     Some((quantile(&mut speeds, 0.999)? * AUTO_SPEED_FACTOR).max(MIN_AUTO_SPEED_MM_S))
 }
 
-fn reference_markers(
-    choice: &HeadChoice,
-    labels: &[String],
+/// RMS distance (mm) of each reference marker from its template place, over the prepared
+/// (head-coordinate) frames: how rigid the reference held.
+fn reference_residuals(
+    head: &ica_core::stabilise::HeadReference,
     xyz: &[f32],
     missing: &[bool],
-) -> Result<Vec<usize>> {
-    match choice {
-        HeadChoice::None => Ok(Vec::new()),
-        HeadChoice::Auto => {
-            let stride = (missing.len() / labels.len().max(1) / 2000).max(1);
-            let chosen = choose_reference(xyz, missing, labels.len(), AUTO_REFERENCE_COUNT, stride);
-            if chosen.len() < 3 {
-                bail!("could not find 3 rigid reference markers; pass --head-reference none or name them");
-            }
-            Ok(chosen)
+    n: usize,
+) -> Vec<(usize, f64)> {
+    let frames = missing.len() / n.max(1);
+    // Head coordinates put the template's centroid where the Procrustes fit put it: compare
+    // each frame's reference shape, centred, to the centred template.
+    let mut sq = vec![0.0f64; head.markers.len()];
+    let mut count = vec![0usize; head.markers.len()];
+    for f in 0..frames {
+        let present: Vec<usize> = (0..head.markers.len())
+            .filter(|&k| !missing[f * n + head.markers[k]])
+            .collect();
+        if present.len() < 3 {
+            continue;
         }
-        HeadChoice::Labels(patterns) => {
-            let regions = Regions {
-                regions: [("head_reference".to_string(), patterns.clone())].into(),
-            };
-            let idx = regions
-                .resolve(labels)
-                .map_err(|e| anyhow::anyhow!("head reference: {e}"))?
-                .remove("head_reference")
-                .unwrap_or_default();
-            if idx.len() < 3 {
-                bail!(
-                    "head stabilisation needs at least 3 reference markers, got {}",
-                    idx.len()
-                );
+        let at = |k: usize, a: usize| f64::from(xyz[(f * n + head.markers[k]) * 3 + a]);
+        let mut c = [0.0; 3];
+        let mut t = [0.0; 3];
+        for &k in &present {
+            for a in 0..3 {
+                c[a] += at(k, a) / present.len() as f64;
+                t[a] += head.template[k][a] / present.len() as f64;
             }
-            Ok(idx)
+        }
+        for &k in &present {
+            sq[k] += (0..3)
+                .map(|a| (at(k, a) - c[a] - (head.template[k][a] - t[a])).powi(2))
+                .sum::<f64>();
+            count[k] += 1;
         }
     }
+    head.markers
+        .iter()
+        .enumerate()
+        .map(|(k, &m)| (m, (sq[k] / count[k].max(1) as f64).sqrt()))
+        .collect()
 }

@@ -1,0 +1,432 @@
+//! How good a set of markers is as a head reference, measured on a sample of the capture.
+//!
+//! - **Deformation**: the fiducial localisation error (FLE), the RMS distance between each
+//!   marker and the rigid fit of the group's template, corrected for the fit's own degrees of
+//!   freedom (`E FRE² = (1 − 2/N) FLE²`, Fitzpatrick, West & Maurer 1998). The worst 1 % of
+//!   frames are left out (glitches the speed check missed).
+//! - **Pose error at the face**: the target registration error of the same paper,
+//!   `TRE²(r) = FLE²/N · (1 + ⅓ Σ_k d_k²/f_k²)` (`d_k` the target's distance from the group's
+//!   principal axis `k`, `f_k` the group's RMS distance from it), averaged over the other
+//!   markers: how far stabilisation will misplace the face, frame by frame.
+//! - **Head motion**: the RMS world motion of head-fixed points at the face markers' places.
+//! - **Leakage**: in the group's own coordinates, the median share of another marker's motion
+//!   that the group's pose explains. A true head leaves the face's expression alone (low); a
+//!   forehead lifting with the brows pushes its own motion, inverted, onto every other marker
+//!   (high).
+
+use nalgebra::{Matrix3, SMatrix, SVector, SymmetricEigen, Vector3};
+
+use super::search::{quantile, MarkerFrames, MIN_MOTION_MM, MOTION_FACTOR, RIGID_NOISE_FACTOR};
+use super::{centre, kabsch, point, Pose};
+
+/// The assessment of one candidate reference group. See the module docs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroupAssessment {
+    /// Marker indices, ascending.
+    pub markers: Vec<usize>,
+    /// Deformation of the group (FLE), mm RMS per marker.
+    pub deformation_mm: f64,
+    /// Whether the deformation is within the capture's noise.
+    pub rigid: bool,
+    /// Head motion at the face, mm RMS.
+    pub motion_mm: f64,
+    /// Expected pose error at the face (TRE), mm RMS.
+    pub pose_error_mm: f64,
+    /// Median share of the other markers' motion the group's pose explains, 0..1.
+    pub leakage: f64,
+
+    /// The capture's noise per coordinate, mm.
+    pub noise_mm: f64,
+}
+
+impl GroupAssessment {
+    /// Whether the head moves enough for stabilising on this group to pay: more than
+    /// [`MOTION_FACTOR`] × the pose error it adds, and more than [`MIN_MOTION_MM`].
+    pub fn motion_is_measurable(&self) -> bool {
+        self.motion_mm > MOTION_FACTOR * self.pose_error_mm && self.motion_mm > MIN_MOTION_MM
+    }
+}
+
+/// Sampled frames, each with its two neighbours, glitches masked.
+pub(crate) struct Sample {
+    /// 3 frames per sample (before, at, after), markers x 3 each.
+    xyz: Vec<f32>,
+    /// Present (not missing, not a glitch), 3 frames per sample, markers each.
+    present: Vec<bool>,
+    markers: usize,
+    pub(crate) glitches: usize,
+}
+
+/// Glitch speed: this multiple of the 99.9th percentile speed, at least [`MIN_GLITCH_MM_S`]
+/// (per frame here: the sample has no rate, so speeds are mm per frame).
+const GLITCH_FACTOR: f64 = 4.0;
+/// Smallest glitch step, mm per frame.
+const MIN_GLITCH_STEP_MM: f64 = 4.0;
+
+impl Sample {
+    pub(crate) fn draw(frames: &MarkerFrames<'_>, max_frames: usize) -> Sample {
+        let n = frames.markers;
+        let inner: usize = frames.takes.iter().map(|r| r.len().saturating_sub(2)).sum();
+        let stride = (inner / max_frames.max(1)).max(1);
+        let mut xyz = Vec::new();
+        let mut present = Vec::new();
+        let mut k = 0usize;
+        for take in frames.takes {
+            for f in take.start + 1..take.end.saturating_sub(1) {
+                k += 1;
+                if k % stride != 0 {
+                    continue;
+                }
+                for g in f - 1..=f + 1 {
+                    xyz.extend_from_slice(&frames.xyz[g * n * 3..(g + 1) * n * 3]);
+                    present.extend(frames.missing[g * n..(g + 1) * n].iter().map(|m| !m));
+                }
+            }
+        }
+        let mut sample = Sample {
+            xyz,
+            present,
+            markers: n,
+            glitches: 0,
+        };
+        sample.mask_glitches();
+        sample
+    }
+
+    /// Sampled frames (centres).
+    pub(crate) fn frames(&self) -> usize {
+        self.present.len() / (3 * self.markers.max(1))
+    }
+
+    /// Storage indices of sample `s`'s three frames.
+    pub(crate) fn triple(&self, s: usize) -> [usize; 3] {
+        [3 * s, 3 * s + 1, 3 * s + 2]
+    }
+
+    /// A present sample's x y z.
+    pub(crate) fn get(&self, frame: usize, marker: usize) -> Option<&[f32]> {
+        let i = frame * self.markers + marker;
+        self.present[i].then(|| &self.xyz[i * 3..i * 3 + 3])
+    }
+
+    fn step(&self, a: usize, b: usize, m: usize) -> Option<f64> {
+        Some((point(self.get(a, m)?, 0) - point(self.get(b, m)?, 0)).norm())
+    }
+
+    /// Marks samples whose step to a neighbour is a glitch (see [`GLITCH_FACTOR`]).
+    fn mask_glitches(&mut self) {
+        let mut steps = Vec::new();
+        for s in 0..self.frames() {
+            let [b, a, n] = self.triple(s);
+            for m in 0..self.markers {
+                steps.extend(self.step(b, a, m));
+                steps.extend(self.step(a, n, m));
+            }
+        }
+        let limit = (GLITCH_FACTOR * quantile(&mut steps, 0.999)).max(MIN_GLITCH_STEP_MM);
+        for s in 0..self.frames() {
+            let [b, a, n] = self.triple(s);
+            for m in 0..self.markers {
+                let jump = |x: Option<f64>| x.is_some_and(|v| v > limit);
+                if jump(self.step(b, a, m)) || jump(self.step(a, n, m)) {
+                    for g in [b, a, n] {
+                        let i = g * self.markers + m;
+                        self.glitches += usize::from(self.present[i]);
+                        self.present[i] = false;
+                    }
+                }
+            }
+        }
+    }
+
+    pub(crate) fn present_share(&self, m: usize) -> f64 {
+        let at = (0..self.frames()).filter(|&s| self.get(3 * s + 1, m).is_some());
+        at.count() as f64 / self.frames().max(1) as f64
+    }
+
+    /// Median over `markers` and axes of the robust spread of second differences / √6.
+    pub(crate) fn noise_mm(&self, markers: &[usize]) -> f64 {
+        let mut per_axis = Vec::new();
+        let mut d2 = Vec::new();
+        for &m in markers {
+            for axis in 0..3 {
+                d2.clear();
+                for s in 0..self.frames() {
+                    let [b, a, n] = self.triple(s);
+                    if let (Some(p), Some(q), Some(r)) =
+                        (self.get(b, m), self.get(a, m), self.get(n, m))
+                    {
+                        d2.push(f64::from(p[axis]) - 2.0 * f64::from(q[axis]) + f64::from(r[axis]));
+                    }
+                }
+                if d2.len() >= 10 {
+                    per_axis.push(super::search::mad(&mut d2) / 6f64.sqrt());
+                }
+            }
+        }
+        super::search::median(&mut per_axis)
+    }
+}
+
+/// One frame of the group: its pose and fit residual, and the other markers in head
+/// coordinates.
+struct Fitted {
+    pose: Pose,
+    residual_sq: f64,
+}
+
+/// Assesses `group` as a head reference against the `candidates` (markers present enough);
+/// `None` when fewer than three of its markers are ever seen together or they are collinear.
+pub(crate) fn assess_group(
+    sample: &Sample,
+    group: &[usize],
+    candidates: &[usize],
+    noise_mm: f64,
+) -> Option<GroupAssessment> {
+    let template = template(sample, group)?;
+    let others: Vec<usize> = candidates
+        .iter()
+        .copied()
+        .filter(|m| !group.contains(m))
+        .collect();
+    let fits: Vec<(usize, Fitted)> = (0..sample.frames())
+        .filter_map(|s| Some((3 * s + 1, fit(sample, group, &template, 3 * s + 1)?)))
+        .collect();
+    if fits.is_empty() {
+        return None;
+    }
+    let n = group.len() as f64;
+    let mut res: Vec<f64> = fits.iter().map(|(_, f)| f.residual_sq).collect();
+    res.sort_by(f64::total_cmp);
+    res.truncate(((res.len() as f64 * 0.99).ceil() as usize).max(1));
+    let fre_sq = res.iter().sum::<f64>() / res.len() as f64;
+    let deformation_mm = (fre_sq / (1.0 - 2.0 / n).max(1.0 / 3.0)).sqrt();
+    let targets = head_means(sample, &fits, &others);
+    let pose_error_mm = tre(&template, &targets, deformation_mm);
+    let motion_mm = motion(&fits, &targets);
+    let leakage = leakage(sample, &fits, &others);
+    Some(GroupAssessment {
+        markers: group.to_vec(),
+        rigid: deformation_mm <= RIGID_NOISE_FACTOR * 3f64.sqrt() * noise_mm,
+        deformation_mm,
+        motion_mm,
+        pose_error_mm,
+        leakage,
+        noise_mm,
+    })
+}
+
+/// The group's shape by generalised Procrustes averaging over the sample.
+fn template(sample: &Sample, group: &[usize]) -> Option<Vec<[f64; 3]>> {
+    let complete = |f: usize| group.iter().all(|&m| sample.get(f, m).is_some());
+    let first = (0..sample.frames())
+        .map(|s| 3 * s + 1)
+        .find(|&f| complete(f))?;
+    let mut template: Vec<[f64; 3]> = group
+        .iter()
+        .map(|&m| point(sample.get(first, m).expect("complete frame"), 0).into())
+        .collect();
+    centre(&mut template);
+    for _ in 0..3 {
+        let mut sum = vec![Vector3::<f64>::zeros(); group.len()];
+        let mut count = vec![0usize; group.len()];
+        for s in 0..sample.frames() {
+            let f = 3 * s + 1;
+            let Some(pose) = fit(sample, group, &template, f).map(|x| x.pose) else {
+                continue;
+            };
+            let inv = pose.rotation.transpose();
+            for (k, &m) in group.iter().enumerate() {
+                if let Some(p) = sample.get(f, m) {
+                    sum[k] += inv * (point(p, 0) - pose.translation);
+                    count[k] += 1;
+                }
+            }
+        }
+        for k in 0..group.len() {
+            if count[k] > 0 {
+                template[k] = (sum[k] / count[k] as f64).into();
+            }
+        }
+        centre(&mut template);
+    }
+    let own = template.iter().map(|p| (p, Vector3::from(*p)));
+    kabsch(own).map(|_| template)
+}
+
+fn fit(sample: &Sample, group: &[usize], template: &[[f64; 3]], f: usize) -> Option<Fitted> {
+    let pairs = group
+        .iter()
+        .zip(template)
+        .filter_map(|(&m, t)| Some((t, point(sample.get(f, m)?, 0))));
+    let (pose, used) = kabsch(pairs.clone())?;
+    let sq: f64 = pairs
+        .map(|(p, q)| (pose.rotation * Vector3::from(*p) + pose.translation - q).norm_squared())
+        .sum();
+    Some(Fitted {
+        pose,
+        residual_sq: sq / used as f64,
+    })
+}
+
+/// Mean head-coordinate position of each other marker.
+fn head_means(sample: &Sample, fits: &[(usize, Fitted)], others: &[usize]) -> Vec<Vector3<f64>> {
+    others
+        .iter()
+        .filter_map(|&m| {
+            let (mut sum, mut count) = (Vector3::zeros(), 0usize);
+            for (f, fitted) in fits {
+                if let Some(p) = sample.get(*f, m) {
+                    let pose = &fitted.pose;
+                    sum += pose.rotation.transpose() * (point(p, 0) - pose.translation);
+                    count += 1;
+                }
+            }
+            (count > 0).then(|| sum / count as f64)
+        })
+        .collect()
+}
+
+/// Fitzpatrick's TRE averaged (RMS) over `targets`, for a group of the template's shape.
+fn tre(template: &[[f64; 3]], targets: &[Vector3<f64>], fle: f64) -> f64 {
+    if targets.is_empty() {
+        return fle;
+    }
+    let n = template.len() as f64;
+    let mut cov = Matrix3::zeros();
+    for p in template {
+        let v = Vector3::from(*p);
+        cov += v * v.transpose() / n;
+    }
+    let eig = SymmetricEigen::new(cov);
+    let total: f64 = eig.eigenvalues.sum();
+    let sum_sq: f64 = targets
+        .iter()
+        .map(|r| {
+            let ratio: f64 = (0..3)
+                .map(|k| {
+                    let axis = eig.eigenvectors.column(k);
+                    // Squared distance from axis k: |r|² minus its part along the axis; the
+                    // group's RMS squared distance from the axis: the other two variances.
+                    let d2 = r.norm_squared() - r.dot(&axis).powi(2);
+                    let f2 = (total - eig.eigenvalues[k]).max(1e-9);
+                    d2 / f2
+                })
+                .sum();
+            fle * fle / n * (1.0 + ratio / 3.0)
+        })
+        .sum();
+    (sum_sq / targets.len() as f64).sqrt()
+}
+
+/// RMS world motion of head-fixed points at `targets`.
+fn motion(fits: &[(usize, Fitted)], targets: &[Vector3<f64>]) -> f64 {
+    let (mut sq, mut count) = (0.0, 0usize);
+    for r in targets {
+        let world: Vec<Vector3<f64>> = fits
+            .iter()
+            .map(|(_, f)| f.pose.rotation * r + f.pose.translation)
+            .collect();
+        let mean = world.iter().sum::<Vector3<f64>>() / world.len() as f64;
+        sq += world.iter().map(|w| (w - mean).norm_squared()).sum::<f64>();
+        count += world.len();
+    }
+    (sq / count.max(1) as f64).sqrt()
+}
+
+/// Pose parameters of a frame: translation (mm) and the rotation's axis times the sine of its
+/// angle, `(R − Rᵀ)/2` read as a vector (exact and free of `acos` at small angles).
+fn pose_params(p: &Pose) -> SVector<f64, 6> {
+    let r = &p.rotation;
+    let rv = Vector3::new(
+        (r[(2, 1)] - r[(1, 2)]) / 2.0,
+        (r[(0, 2)] - r[(2, 0)]) / 2.0,
+        (r[(1, 0)] - r[(0, 1)]) / 2.0,
+    );
+    SVector::<f64, 6>::from_column_slice(&[
+        p.translation.x,
+        p.translation.y,
+        p.translation.z,
+        rv.x,
+        rv.y,
+        rv.z,
+    ])
+}
+
+/// Median over `others` of the share of their head-coordinate variance explained linearly by
+/// the pose parameters.
+fn leakage(sample: &Sample, fits: &[(usize, Fitted)], others: &[usize]) -> f64 {
+    let params: Vec<SVector<f64, 6>> = fits.iter().map(|(_, f)| pose_params(&f.pose)).collect();
+    let mut shares: Vec<f64> = others
+        .iter()
+        .filter_map(|&m| {
+            let rows: Vec<(SVector<f64, 7>, Vector3<f64>)> = fits
+                .iter()
+                .zip(&params)
+                .filter_map(|((f, fitted), p)| {
+                    let x = point(sample.get(*f, m)?, 0);
+                    let pose = &fitted.pose;
+                    let head = pose.rotation.transpose() * (x - pose.translation);
+                    Some((p.push(1.0), head))
+                })
+                .collect();
+            explained_share(&rows)
+        })
+        .collect();
+    super::search::median(&mut shares)
+}
+
+/// Share of the variance of `y` explained by a least-squares fit on `x` (with intercept).
+fn explained_share(rows: &[(SVector<f64, 7>, Vector3<f64>)]) -> Option<f64> {
+    if rows.len() < 20 {
+        return None;
+    }
+    let n = rows.len() as f64;
+    let mean_x = rows.iter().map(|r| r.0).sum::<SVector<f64, 7>>() / n;
+    let mean_y = rows.iter().map(|r| r.1).sum::<Vector3<f64>>() / n;
+    let mut xtx = SMatrix::<f64, 7, 7>::zeros();
+    let mut xty = SMatrix::<f64, 7, 3>::zeros();
+    let mut total = 0.0;
+    for (x, y) in rows {
+        let mut xc = x - mean_x;
+        xc[6] = 1.0;
+        let yc = y - mean_y;
+        xtx += xc * xc.transpose();
+        xty += xc * yc.transpose();
+        total += yc.norm_squared();
+    }
+    // Scale-free ridge so degenerate pose parameters (no rotation at all) stay solvable.
+    let ridge = 1e-9 * xtx.trace().max(1e-12);
+    for i in 0..7 {
+        xtx[(i, i)] += ridge;
+    }
+    let beta = xtx.cholesky()?.solve(&xty);
+    let explained: f64 = (beta.transpose() * xty).trace();
+    (total > 0.0).then(|| (explained / total).clamp(0.0, 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn explained_share_of_a_linear_response_is_one_and_of_noise_is_small() {
+        let rows: Vec<(SVector<f64, 7>, Vector3<f64>)> = (0..200)
+            .map(|i| {
+                let t = i as f64 * 0.1;
+                let x = SVector::<f64, 7>::from_column_slice(&[
+                    t.sin() * 20.0,
+                    t.cos(),
+                    (2.0 * t).sin(),
+                    0.01 * (3.0 * t).cos(),
+                    0.02 * t.sin(),
+                    0.0,
+                    1.0,
+                ]);
+                (x, Vector3::new(2.0 * x[0], -x[1], 0.5 * x[3]))
+            })
+            .collect();
+        let share = explained_share(&rows).expect("solvable");
+        assert!((share - 1.0).abs() < 1e-6, "{share}");
+    }
+}

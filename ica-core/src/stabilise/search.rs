@@ -1,0 +1,326 @@
+//! Finding the head reference in a capture that names none: markers that are rigid among
+//! themselves, that carry the head's motion and not the face's.
+//!
+//! 1. **Sample.** Up to [`SearchParams::max_frames`] frames, evenly over the takes, each with its
+//!    two neighbours (for noise). Samples moving faster than 4 × the 99.9th percentile speed
+//!    (at least 500 mm/s) are glitches (swaps, spikes) and left out; so are markers present in
+//!    fewer than [`SearchParams::min_present`] of the sampled frames.
+//! 2. **Noise.** The capture's own per-coordinate noise `σ`: the median over markers and axes
+//!    of the robust spread of second differences, `1.4826 · MAD(x[t−1] − 2x[t] + x[t+1]) / √6`.
+//! 3. **Pairs.** For every pair, its distance's robust spread beyond noise (the *excess*,
+//!    `√(spread² − noise²)`), relative to its length (the *strain*). Optical systems measure a
+//!    face-sized distance to better than [`RIGID_STRAIN`] (1 %); skin moves by several per cent
+//!    (a brow raise stretches the forehead by 5-10 %, speech moves the jaw by 20 %).
+//! 4. **Groups.** Candidate groups: every maximal set grown greedily from the most rigid pairs
+//!    whose pairs all stay within the strain limit, and the greedy least-deforming set.
+//! 5. **Assess** each candidate ([`super::assess`]): deformation, pose error at the face, head
+//!    motion, and how much of its motion the face would inherit.
+//!
+//! [`choose`] then picks, among the candidates least tied to the face, the one with the
+//! smallest pose error at the face.
+
+use std::ops::Range;
+
+use super::assess::{assess_group, GroupAssessment, Sample};
+use super::point;
+
+/// Largest strain (excess spread / length) of a rigid pair. See the module docs.
+pub const RIGID_STRAIN: f64 = 0.01;
+/// A group whose pose explains at least this share of the other markers' motion in its own
+/// coordinates is a part of the face (a forehead lifting with the brows), not the head.
+pub const FACE_LEAKAGE: f64 = 0.6;
+/// Candidates whose leakage is within this of the least leaking one compete on pose error.
+pub const LEAKAGE_TOLERANCE: f64 = 0.1;
+/// Head motion counts as measurable when it moves the face by more than this many times the
+/// pose error the reference itself would add...
+pub const MOTION_FACTOR: f64 = 3.0;
+/// ...and by more than this (mm RMS).
+pub const MIN_MOTION_MM: f64 = 0.3;
+/// Deformation (mm RMS per marker) below this multiple of the noise of one 3-D sample
+/// (`√3 σ`) counts as rigid within the capture's noise.
+pub const RIGID_NOISE_FACTOR: f64 = 2.0;
+
+/// Knobs of [`search_reference`]; the defaults are the documented constants.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchParams {
+    /// Frames sampled at most.
+    pub max_frames: usize,
+    /// Markers present in fewer than this share of the sampled frames are not candidates.
+    pub min_present: f64,
+    /// [`RIGID_STRAIN`].
+    pub rigid_strain: f64,
+    /// Candidate groups grown (from the most rigid pairs).
+    pub max_groups: usize,
+    /// Size of the least-deforming set when no rigid group exists.
+    pub least_deforming: usize,
+}
+
+impl Default for SearchParams {
+    fn default() -> SearchParams {
+        SearchParams {
+            max_frames: 2000,
+            min_present: 0.8,
+            rigid_strain: RIGID_STRAIN,
+            max_groups: 40,
+            least_deforming: 6,
+        }
+    }
+}
+
+/// Frames of a capture in one marker order: `xyz` frames x markers x 3 (mm), `missing` frames
+/// x markers, and the frame range of each take (differences never cross a take boundary).
+#[derive(Debug, Clone, Copy)]
+pub struct MarkerFrames<'a> {
+    /// Positions, frames x markers x 3 (mm).
+    pub xyz: &'a [f32],
+    /// Missing flags, frames x markers.
+    pub missing: &'a [bool],
+    /// Markers per frame.
+    pub markers: usize,
+    /// Frame range of each take.
+    pub takes: &'a [Range<usize>],
+}
+
+/// What [`search_reference`] measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReferenceSearch {
+    /// The capture's noise per coordinate (mm).
+    pub noise_mm: f64,
+    /// Frames sampled.
+    pub frames: usize,
+    /// Samples left out as glitches.
+    pub glitches: usize,
+    /// Candidate groups, assessed, least leakage first.
+    pub candidates: Vec<GroupAssessment>,
+}
+
+/// Which candidate [`choose`] took, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Choice {
+    /// Stabilise on this group.
+    Stabilise(GroupAssessment),
+    /// The best group moves too little to be worth it.
+    StillHead(GroupAssessment),
+    /// Every candidate moves with the face.
+    MovesWithFace(GroupAssessment),
+    /// No candidate of three markers or more.
+    NoCandidate,
+}
+
+/// Picks a head reference among assessed candidates: among the groups least tied to the face
+/// (leakage below [`FACE_LEAKAGE`] and within [`LEAKAGE_TOLERANCE`] of the least), the one with
+/// the smallest pose error at the face; stabilised only when the head's motion is measurable.
+///
+/// Leakage decides first because a rigid part of the face (a jaw, a forehead lifting as a
+/// block) can be as rigid as the head, but drags the face with it. Where head motion follows
+/// the expression (singing), every candidate leaks about as much and the pose error decides.
+pub fn choose(candidates: &[GroupAssessment]) -> Choice {
+    let least = candidates
+        .iter()
+        .map(|c| c.leakage)
+        .fold(f64::INFINITY, f64::min);
+    let head_like = candidates
+        .iter()
+        .filter(|c| c.leakage < FACE_LEAKAGE && c.leakage <= least + LEAKAGE_TOLERANCE)
+        .min_by(|a, b| a.pose_error_mm.total_cmp(&b.pose_error_mm));
+    match head_like {
+        Some(best) if best.motion_is_measurable() => Choice::Stabilise(best.clone()),
+        Some(best) => Choice::StillHead(best.clone()),
+        None => match candidates.first() {
+            Some(c) => Choice::MovesWithFace(c.clone()),
+            None => Choice::NoCandidate,
+        },
+    }
+}
+
+/// Searches a capture for its head reference. See the module docs.
+pub fn search_reference(frames: &MarkerFrames<'_>, params: &SearchParams) -> ReferenceSearch {
+    let sample = Sample::draw(frames, params.max_frames);
+    let candidates_markers: Vec<usize> = (0..frames.markers)
+        .filter(|&m| sample.present_share(m) >= params.min_present)
+        .collect();
+    let noise_mm = sample.noise_mm(&candidates_markers);
+    let pairs = PairTable::measure(&sample, &candidates_markers);
+    let mut groups = rigid_groups(&pairs, params);
+    let ld = least_deforming(&pairs, params.least_deforming);
+    if ld.len() >= 3 && !groups.contains(&ld) {
+        groups.push(ld);
+    }
+    let mut candidates: Vec<GroupAssessment> = groups
+        .iter()
+        .filter_map(|g| assess_group(&sample, g, &candidates_markers, noise_mm))
+        .collect();
+    candidates.sort_by(|a, b| a.leakage.total_cmp(&b.leakage));
+    ReferenceSearch {
+        noise_mm,
+        frames: sample.frames(),
+        glitches: sample.glitches,
+        candidates,
+    }
+}
+
+/// Assesses a given group (markers the user or a naming convention chose).
+pub fn assess_named(frames: &MarkerFrames<'_>, markers: &[usize]) -> Option<GroupAssessment> {
+    let sample = Sample::draw(frames, SearchParams::default().max_frames);
+    let all: Vec<usize> = (0..frames.markers)
+        .filter(|&m| sample.present_share(m) > 0.0)
+        .collect();
+    let noise_mm = sample.noise_mm(&all);
+    assess_group(&sample, markers, &all, noise_mm)
+}
+
+/// Excess strain of every candidate pair (∞ where too few samples overlap).
+struct PairTable {
+    markers: Vec<usize>,
+    strain: Vec<f64>,
+}
+
+impl PairTable {
+    fn measure(sample: &Sample, markers: &[usize]) -> PairTable {
+        let k = markers.len();
+        let mut strain = vec![f64::INFINITY; k * k];
+        let mut d = Vec::with_capacity(sample.frames());
+        let mut d2 = Vec::with_capacity(sample.frames());
+        for i in 0..k {
+            for j in i + 1..k {
+                let (a, b) = (markers[i], markers[j]);
+                d.clear();
+                d2.clear();
+                for s in 0..sample.frames() {
+                    let dist = |f: usize| -> Option<f64> {
+                        let (pa, pb) = (sample.get(f, a)?, sample.get(f, b)?);
+                        Some((point(pa, 0) - point(pb, 0)).norm())
+                    };
+                    let [before, at, after] = sample.triple(s);
+                    if let Some(x) = dist(at) {
+                        d.push(x);
+                        if let (Some(p), Some(n)) = (dist(before), dist(after)) {
+                            d2.push(p - 2.0 * x + n);
+                        }
+                    }
+                }
+                if d.len() < 10 || d2.len() < 10 {
+                    continue;
+                }
+                let length = median(&mut d);
+                let spread = mad(&mut d);
+                let noise = mad(&mut d2) / 6f64.sqrt();
+                let excess = (spread * spread - noise * noise).max(0.0).sqrt();
+                let s = excess / length.max(1e-6);
+                strain[i * k + j] = s;
+                strain[j * k + i] = s;
+            }
+        }
+        PairTable {
+            markers: markers.to_vec(),
+            strain,
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.markers.len()
+    }
+
+    fn strain(&self, i: usize, j: usize) -> f64 {
+        self.strain[i * self.len() + j]
+    }
+
+    /// Pairs (i < j) by increasing strain.
+    fn sorted_pairs(&self) -> Vec<(usize, usize)> {
+        let k = self.len();
+        let mut pairs: Vec<(usize, usize)> = (0..k)
+            .flat_map(|i| (i + 1..k).map(move |j| (i, j)))
+            .filter(|&(i, j)| self.strain(i, j).is_finite())
+            .collect();
+        pairs.sort_by(|a, b| self.strain(a.0, a.1).total_cmp(&self.strain(b.0, b.1)));
+        pairs
+    }
+
+    fn mean_strain(&self, c: usize, group: &[usize]) -> f64 {
+        group.iter().map(|&g| self.strain(c, g)).sum::<f64>() / group.len() as f64
+    }
+
+    fn to_markers(&self, group: &[usize]) -> Vec<usize> {
+        let mut out: Vec<usize> = group.iter().map(|&g| self.markers[g]).collect();
+        out.sort_unstable();
+        out
+    }
+}
+
+/// Maximal groups within the strain limit, each grown from one of the most rigid pairs by
+/// adding the marker closest (in mean strain) to the group while every pair stays rigid.
+fn rigid_groups(pairs: &PairTable, params: &SearchParams) -> Vec<Vec<usize>> {
+    let limit = params.rigid_strain;
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let seeds = pairs
+        .sorted_pairs()
+        .into_iter()
+        .take_while(|&(i, j)| pairs.strain(i, j) <= limit)
+        .take(params.max_groups);
+    for (i, j) in seeds {
+        let mut group = vec![i, j];
+        loop {
+            let next = (0..pairs.len())
+                .filter(|c| !group.contains(c))
+                .filter(|&c| group.iter().all(|&g| pairs.strain(c, g) <= limit))
+                .min_by(|&a, &b| {
+                    pairs
+                        .mean_strain(a, &group)
+                        .total_cmp(&pairs.mean_strain(b, &group))
+                });
+            match next {
+                Some(c) => group.push(c),
+                None => break,
+            }
+        }
+        let markers = pairs.to_markers(&group);
+        if markers.len() >= 3 && !groups.contains(&markers) {
+            groups.push(markers);
+        }
+    }
+    groups
+}
+
+/// The `count` markers grown greedily from the most rigid pair by least mean strain, whatever
+/// the strain: the fallback when nothing is rigid.
+fn least_deforming(pairs: &PairTable, count: usize) -> Vec<usize> {
+    let Some(&(i, j)) = pairs.sorted_pairs().first() else {
+        return Vec::new();
+    };
+    let mut group = vec![i, j];
+    while group.len() < count.min(pairs.len()) {
+        let next = (0..pairs.len())
+            .filter(|c| !group.contains(c))
+            .map(|c| (c, pairs.mean_strain(c, &group)))
+            .filter(|(_, s)| s.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match next {
+            Some((c, _)) => group.push(c),
+            None => break,
+        }
+    }
+    pairs.to_markers(&group)
+}
+
+/// Median (reorders `v`); 0 when empty.
+pub(crate) fn median(v: &mut [f64]) -> f64 {
+    quantile(v, 0.5)
+}
+
+/// `q`-quantile by selection (reorders `v`); 0 when empty.
+pub(crate) fn quantile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let k = ((v.len() - 1) as f64 * q).round() as usize;
+    *v.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
+/// `1.4826 · MAD`, a robust standard deviation (reorders `v`).
+pub(crate) fn mad(v: &mut [f64]) -> f64 {
+    let m = median(v);
+    for x in v.iter_mut() {
+        *x = (*x - m).abs();
+    }
+    1.4826 * median(v)
+}
