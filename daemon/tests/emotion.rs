@@ -7,7 +7,7 @@ use std::path::Path;
 use replay::synth::{load_truth, Synth, SynthParams};
 
 mod common;
-use common::ok as emoshift;
+use common::{corr, ok as emoshift};
 
 fn params(seed: u64, sentences: usize) -> SynthParams {
     SynthParams {
@@ -50,18 +50,6 @@ fn session(dir: &Path, seed: u64, sentences: usize) {
         &format!("{d}/report"),
         "--write-model",
     ]);
-}
-
-fn corr(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        sab += (x - ma) * (y - mb);
-        saa += (x - ma) * (x - ma);
-        sbb += (y - mb) * (y - mb);
-    }
-    sab / (saa * sbb).sqrt().max(1e-300)
 }
 
 /// Component series of every take (concatenated) from `emoshift project`.

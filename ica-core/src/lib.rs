@@ -5,6 +5,7 @@ pub mod dtw;
 pub mod edit;
 pub mod fastica;
 pub mod fit;
+pub mod impute;
 pub mod interpret;
 pub mod model;
 pub mod project;

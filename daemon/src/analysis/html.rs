@@ -5,6 +5,74 @@ use std::fmt::Write as _;
 use super::svg::role_colour;
 use super::Report;
 
+/// The model's quality report: head decision, stability, residuals and warnings.
+fn quality_section(q: &ica_core::quality::ModelQuality) -> String {
+    if q.is_empty() {
+        return "<h2>Model quality</h2><p>Not recorded: the model was trained before quality \
+                reports existed.</p>"
+            .into();
+    }
+    let mut out = String::from("<h2>Model quality</h2><ul>");
+    if let Some(h) = &q.head {
+        let _ = write!(
+            out,
+            "<li>Head ({}): {}</li>",
+            esc(&h.source),
+            esc(&h.verdict)
+        );
+    }
+    if !q.stability.is_empty() {
+        let s: Vec<String> = q
+            .stability
+            .iter()
+            .enumerate()
+            .map(|(i, v)| format!("c{i} {v:.2}"))
+            .collect();
+        let _ = write!(
+            out,
+            "<li>Stability across restarts (best-match |corr|): {}</li>",
+            s.join(", ")
+        );
+    }
+    let r: Vec<String> = q
+        .residual_by_region_mm
+        .iter()
+        .map(|(n, v)| format!("{} {v:.2}", esc(n)))
+        .collect();
+    if !r.is_empty() {
+        let _ = write!(
+            out,
+            "<li>Reconstruction residual (mm RMS per marker): {}</li>",
+            r.join(", ")
+        );
+    }
+    if let (Some(mm), Some(marker)) = (q.slow_residual_mm, &q.slow_residual_marker) {
+        let _ = write!(
+            out,
+            "<li>Largest slow signal left out: {mm:.2} mm RMS at {}</li>",
+            esc(marker)
+        );
+    }
+    out.push_str("</ul>");
+    if q.warnings.is_empty() {
+        out.push_str("<p>No warnings.</p>");
+    } else {
+        out.push_str("<p><b>Warnings</b></p><ul>");
+        for w in &q.warnings {
+            let _ = write!(out, "<li>{}</li>", esc(&w.message));
+        }
+        out.push_str("</ul>");
+    }
+    out
+}
+
+/// Escapes text for HTML.
+fn esc(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
 /// The report page; it references `components.svg` and `timeline.svg` beside it.
 pub fn page(report: &Report) -> String {
     let mut rows = String::new();
@@ -67,6 +135,7 @@ components follow the words.</p>
 <h2>Levels</h2><ul>{levels}</ul>
 <h2>Metrics</h2>
 <table><tr><th>component</th><th>role</th><th>d_emotion</th><th>d_level</th>{header}<th>|M_k| mm</th></tr>{rows}</table>
+{quality}
 <p>Thresholds: emotion when d_level (RMS difference of paired take means) ≥ {r1} × its median
 and ≥ {r2} × its max; otherwise a component takes the role of the region holding ≥ {r3} of its
 summed |d_region| over mouth, eyebrows and eyelids, if that |d_region| is ≥ {r4} × the region's
@@ -75,6 +144,7 @@ largest; else other.</p>
 "#,
         model = report.model,
         manifest = report.manifest,
+        quality = quality_section(&report.quality),
         m = report.components.len(),
         pairs = report.pairs.len(),
         r1 = t.emotion_peak_ratio,

@@ -107,6 +107,8 @@ pub struct Report {
     pub dtw_band_share: f64,
     /// Marker indices of each region.
     pub regions: BTreeMap<String, Vec<String>>,
+    /// The model's own quality report (head decision, stability, residuals, warnings).
+    pub quality: ica_core::quality::ModelQuality,
 }
 
 /// Inputs of an analysis.
@@ -298,6 +300,7 @@ pub fn analyze(
                 )
             })
             .collect(),
+        quality: model.quality().clone(),
     })
 }
 

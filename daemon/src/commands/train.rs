@@ -3,8 +3,10 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use ica_core::fit::{FastIcaParams, FitData};
+use ica_core::fit::{Components, FastIcaParams, FitData};
 use ica_core::model::IcaModel;
+use ica_core::quality::measure::{noise_per_coordinate, TrainingFrames};
+use ica_core::whiten::DEFAULT_VARIANCE_TARGET;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::cli::TrainArgs;
@@ -99,7 +101,33 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     };
     let data = training::prepare(&takes, &options)?;
     let channels = data.labels.len() * 3;
-    let fit_data = FitData::new(&data.samples, channels)?.with_missing(&data.missing)?;
+    // With no count or share asked for, the default share stops at the capture's noise floor.
+    let noise_mm = noise_per_coordinate(&TrainingFrames {
+        samples: &data.samples,
+        missing: &data.missing,
+        channels,
+        takes: &data.takes,
+        rate_hz: data.rate_hz,
+    });
+    let params = if args.components.is_none() && args.variance.is_none() && noise_mm > 0.0 {
+        params.components(Components::VarianceAboveNoise {
+            target: DEFAULT_VARIANCE_TARGET,
+            noise_var: noise_mm * noise_mm,
+        })
+    } else {
+        params
+    };
+    // Gaps (occlusions, glitches) are filled for training, so frames with a gap still teach
+    // the model; `data` keeps the real samples for the quality report.
+    let mut filled = data.samples.clone();
+    let (still_missing, gaps) = ica_core::impute::fill_gaps(
+        &mut filled,
+        &data.missing,
+        channels,
+        params.get_components(),
+    )
+    .context("training failed")?;
+    let fit_data = FitData::new(&filled, channels)?.with_missing(&still_missing)?;
     bar.set_style(ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("static"));
     bar.set_message(format!(
         "whitening and FastICA ({} restarts)",
@@ -124,7 +152,26 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
         .save(std::io::BufWriter::new(file))
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     print_preparation(&data)?;
+    if gaps.frames > 0 || gaps.frames_left_out > 0 {
+        crate::out!(
+            "gaps: {} samples in {} frames filled from the visible markers (PCA, EM); {} frames missing more than half their markers left out",
+            gaps.samples,
+            gaps.frames,
+            gaps.frames_left_out
+        );
+    }
     print_summary(&model, takes.len(), started.elapsed().as_secs_f64())?;
+    if matches!(
+        params.get_components(),
+        Components::VarianceAboveNoise { .. }
+    ) && model.variance_kept() < DEFAULT_VARIANCE_TARGET
+    {
+        crate::out!(
+            "the default {:.0} % of the variance would reach into noise ({noise_mm:.3} mm per coordinate): kept the {} components above the noise floor",
+            100.0 * DEFAULT_VARIANCE_TARGET,
+            model.components()
+        );
+    }
     super::inspect::print_quality(model.quality())?;
     crate::out!("model: {}", args.out.display());
     Ok(())

@@ -28,3 +28,40 @@ pub fn ok(args: &[&str]) -> String {
 pub fn p(path: &Path) -> &str {
     path.to_str().expect("utf-8 path")
 }
+
+/// Pearson correlation of two series.
+pub fn corr(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    sab / (saa * sbb).sqrt().max(1e-300)
+}
+
+/// Component series of `takes` (concatenated) from `emoshift project`, one per component.
+pub fn project_series(model: &Path, takes: &[std::path::PathBuf]) -> Vec<Vec<f64>> {
+    let mut series: Vec<Vec<f64>> = Vec::new();
+    for take in takes {
+        let csv = take.with_extension("components.csv");
+        ok(&["project", "--model", p(model), p(take), "--out", p(&csv)]);
+        let text = std::fs::read_to_string(&csv).expect("components csv");
+        for line in text.lines().skip(1) {
+            let values: Vec<f64> = line
+                .split(',')
+                .skip(2)
+                .map(|v| v.parse().expect("number"))
+                .collect();
+            if series.is_empty() {
+                series = vec![Vec::new(); values.len()];
+            }
+            for (s, v) in series.iter_mut().zip(values) {
+                s.push(v);
+            }
+        }
+    }
+    series
+}

@@ -220,6 +220,18 @@ impl IcaModel {
         &self.report
     }
 
+    /// Variance per channel (mm²) the kept components leave out: the discarded eigenvalues
+    /// of the training covariance over the live channels. 0 when the report holds no
+    /// eigenvalues (models assembled without training).
+    pub fn residual_variance(&self) -> f64 {
+        let r = &self.report;
+        let live = r.channels.saturating_sub(r.dead_channels.len());
+        if r.eigenvalues.len() <= r.components || live == 0 {
+            return 0.0;
+        }
+        r.eigenvalues[r.components..].iter().sum::<f64>() / live as f64
+    }
+
     /// The quality report (empty for models trained before it existed).
     pub fn quality(&self) -> &ModelQuality {
         &self.quality

@@ -1,8 +1,16 @@
-//! Least-squares projection of a frame with missing markers:
-//! `u = argmin ‖M_o u − (x_o − mean_o)‖²` over the observed rows `o`, via the m x m normal
-//! equations `(M_oᵀ M_o) u = M_oᵀ (x_o − mean_o)` and a Cholesky factorisation, all in
-//! buffers sized at construction. f64 here: squaring `M` squares its condition number, which
-//! f32 would not survive.
+//! Projection of a frame with missing markers: the posterior mean of the model read as a
+//! probabilistic PCA, `x = mean + M u + r` with unit-variance components `u` (prior mean
+//! `μ`, the last good `u`) and a residual `r` of variance `σ²` per channel (what the kept
+//! components leave out, [`IcaModel::residual_variance`](crate::IcaModel::residual_variance)):
+//! `(M_oᵀ M_o + σ² I) u = M_oᵀ (x_o − mean_o) + σ² μ` over the observed rows `o`, via a
+//! Cholesky factorisation, all in buffers sized at construction. f64 here: squaring `M`
+//! squares its condition number, which f32 would not survive.
+//!
+//! Plain least squares (`σ² = 0`) is exact for a complete frame, where `Mᵀ r = 0`; with rows
+//! hidden, `M_oᵀ r_o ≠ 0` and the residual leaks into the components the hidden markers
+//! carried most (on Facial-Sing, hiding two cheek markers moved one component by 2.8
+//! standard deviations). The prior lets a component follow the data as far as the visible
+//! markers determine it and no further.
 //!
 //! **Observability.** The Cholesky pivot `p_k` of a Gram matrix is the energy of column `k`
 //! not explained by columns `0..k`. Hiding rows can only shrink pivots (`M_oᵀM_o ≼ MᵀM`), so
@@ -40,6 +48,8 @@ pub(crate) struct MaskedSolver {
     pivots: Vec<f64>,
     rhs: Vec<f64>,
     sol: Vec<f64>,
+    /// Residual variance per channel: the prior's weight (0: plain least squares).
+    residual_var: f64,
 }
 
 /// What a masked solve found.
@@ -56,8 +66,8 @@ fn off(i: usize) -> usize {
 
 impl MaskedSolver {
     /// `mixing_rows`: `M` row-major, n x m (n = markers x 3), of full column rank (the model
-    /// guarantees it).
-    pub(crate) fn new(mixing_rows: &[f64], m: usize) -> MaskedSolver {
+    /// guarantees it); `residual_var`: the residual variance per channel (mm²).
+    pub(crate) fn new(mixing_rows: &[f64], m: usize, residual_var: f64) -> MaskedSolver {
         let tri = off(m);
         let markers = mixing_rows.len() / (3 * m);
         let mut blocks = vec![0.0; markers * tri];
@@ -83,6 +93,11 @@ impl MaskedSolver {
             pivots: vec![0.0; m],
             rhs: vec![0.0; m],
             sol: vec![0.0; m],
+            residual_var: if residual_var.is_finite() {
+                residual_var.max(0.0)
+            } else {
+                0.0
+            },
         };
         s.factor.copy_from_slice(&s.gram_full);
         let ok = cholesky(&mut s.factor, &mut s.pivots_full, m);
@@ -111,6 +126,10 @@ impl MaskedSolver {
         self.build_gram(hidden, hidden_count);
         self.factor.copy_from_slice(&self.gram);
         let ok = cholesky(&mut self.factor, &mut self.pivots, m);
+        // Observability is measured on the data alone (above); the solve adds the prior.
+        if ok && self.residual_var > 0.0 {
+            self.add_prior(prior);
+        }
         let observability = if ok {
             self.pivots
                 .iter()
@@ -153,6 +172,17 @@ impl MaskedSolver {
                 add_into(&mut self.gram, block, 1.0);
             }
         }
+    }
+
+    /// The model's prior: `(G + σ² I) u = b + σ² μ`.
+    fn add_prior(&mut self, prior: &[f32]) {
+        self.factor.copy_from_slice(&self.gram);
+        for (k, (r, &p)) in self.rhs.iter_mut().zip(prior).enumerate() {
+            self.factor[off(k) + k] += self.residual_var;
+            *r += self.residual_var * f64::from(p);
+        }
+        let ok = cholesky(&mut self.factor, &mut self.pivots, self.m);
+        debug_assert!(ok, "G + σ²I is positive definite when G is");
     }
 
     /// Ridge toward `prior`: `(G + λD) u = b + λD prior` with `D = diag(MᵀM)`, `λ =`

@@ -18,8 +18,8 @@
 //! `M·u` is a sum of column axpys, four columns per pass over the output.
 //!
 //! **Missing markers** (a `missing` mask, or any non-finite coordinate) are handled by
-//! least squares on the observed rows; see [`MIN_OBSERVABILITY`] for the method and the
-//! [`FrameStatus`] flags.
+//! least squares on the observed rows with the model's own prior: the posterior mean of a
+//! probabilistic PCA, see [`MIN_OBSERVABILITY`] for the method and the [`FrameStatus`] flags.
 
 mod kernels;
 mod masked;
@@ -122,7 +122,7 @@ impl Projector {
             centered: vec![0.0; n],
             observed: vec![true; n],
             last_u: vec![0.0; m],
-            solver: MaskedSolver::new(&rows, m),
+            solver: MaskedSolver::new(&rows, m, model.residual_variance()),
         }
     }
 

@@ -26,6 +26,8 @@ pub struct GroupAssessment {
     pub markers: Vec<usize>,
     /// Deformation of the group (FLE), mm RMS per marker.
     pub deformation_mm: f64,
+    /// Each marker's RMS distance from its place in the fitted template (mm), group order.
+    pub marker_residual_mm: Vec<f64>,
     /// Whether the deformation is within the capture's noise.
     pub rigid: bool,
     /// Head motion at the face, mm RMS.
@@ -173,6 +175,8 @@ impl Sample {
 struct Fitted {
     pose: Pose,
     residual_sq: f64,
+    /// Squared residual of each group marker (NaN when absent).
+    per_marker_sq: Vec<f64>,
 }
 
 /// Assesses `group` as a head reference against the `candidates` (markers present enough);
@@ -196,6 +200,16 @@ pub(crate) fn assess_group(
         return None;
     }
     let n = group.len() as f64;
+    let marker_residual_mm = (0..group.len())
+        .map(|k| {
+            let (sum, count) = fits
+                .iter()
+                .map(|(_, f)| f.per_marker_sq[k])
+                .filter(|v| !v.is_nan())
+                .fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
+            (sum / count.max(1) as f64).sqrt()
+        })
+        .collect();
     let mut res: Vec<f64> = fits.iter().map(|(_, f)| f.residual_sq).collect();
     res.sort_by(f64::total_cmp);
     res.truncate(((res.len() as f64 * 0.99).ceil() as usize).max(1));
@@ -207,6 +221,7 @@ pub(crate) fn assess_group(
     let leakage = leakage(sample, &fits, &others);
     Some(GroupAssessment {
         markers: group.to_vec(),
+        marker_residual_mm,
         rigid: deformation_mm <= RIGID_NOISE_FACTOR * 3f64.sqrt() * noise_mm,
         deformation_mm,
         motion_mm,
@@ -259,13 +274,22 @@ fn fit(sample: &Sample, group: &[usize], template: &[[f64; 3]], f: usize) -> Opt
         .iter()
         .zip(template)
         .filter_map(|(&m, t)| Some((t, point(sample.get(f, m)?, 0))));
-    let (pose, used) = kabsch(pairs.clone())?;
-    let sq: f64 = pairs
-        .map(|(p, q)| (pose.rotation * Vector3::from(*p) + pose.translation - q).norm_squared())
-        .sum();
+    let (pose, used) = kabsch(pairs)?;
+    let per_marker_sq: Vec<f64> = group
+        .iter()
+        .zip(template)
+        .map(|(&m, t)| match sample.get(f, m) {
+            Some(q) => {
+                (pose.rotation * Vector3::from(*t) + pose.translation - point(q, 0)).norm_squared()
+            }
+            None => f64::NAN,
+        })
+        .collect();
+    let sq: f64 = per_marker_sq.iter().filter(|v| !v.is_nan()).sum();
     Some(Fitted {
         pose,
         residual_sq: sq / used as f64,
+        per_marker_sq,
     })
 }
 

@@ -32,6 +32,17 @@ pub enum Components {
     VarianceTarget(f64),
     /// Exactly `m` components; at least 1 and at most the data's rank.
     Fixed(usize),
+    /// The variance target, but never past the noise floor: only components whose variance
+    /// exceeds the largest eigenvalue white noise of variance `noise_var` per channel would
+    /// reach with this many frames and channels (the Marchenko-Pastur edge
+    /// `σ²(1 + √(channels/frames))²`). On a short or noisy session a fixed share of the
+    /// variance reaches deep into noise; this keeps the components the data can tell from it.
+    VarianceAboveNoise {
+        /// The variance share, as [`Components::VarianceTarget`].
+        target: f64,
+        /// Noise variance per channel (mm²), measured on the capture.
+        noise_var: f64,
+    },
 }
 
 impl Default for Components {
@@ -55,6 +66,9 @@ impl Components {
                     min: MIN_VARIANCE_TARGET,
                     max: MAX_VARIANCE_TARGET,
                 })
+            }
+            Components::VarianceAboveNoise { target, .. } => {
+                Components::VarianceTarget(target).check()
             }
             Components::Fixed(0) => Err(FitError::ZeroComponents),
             _ => Ok(()),
@@ -107,7 +121,7 @@ pub fn whiten<T: Copy + Into<f64>>(
     let sel = stats::select(data)?;
     let needed = match components {
         Components::Fixed(m) => m + 1,
-        Components::VarianceTarget(_) => 2,
+        Components::VarianceTarget(_) | Components::VarianceAboveNoise { .. } => 2,
     }
     .max(2);
     let used = sel.used_frames.len();
@@ -137,7 +151,7 @@ pub fn whiten<T: Copy + Into<f64>>(
         .iter()
         .take_while(|&&l| l > RANK_RELATIVE_EIGENVALUE * lmax)
         .count();
-    let m = choose_m(components, &eigenvalues, rank)?;
+    let m = choose_m(components, &eigenvalues, rank, used)?;
     let total: f64 = eigenvalues.iter().sum();
     let variance_kept = eigenvalues[..m].iter().sum::<f64>() / total;
     let (leading, basis) = eigen::leading(&cov, &eigenvalues, m);
@@ -193,9 +207,32 @@ fn classify_channels(
     Ok((live, dead, cov))
 }
 
+/// The largest eigenvalue of the sample covariance of white noise with variance `noise_var`
+/// per channel (Marchenko-Pastur edge).
+pub fn noise_edge(noise_var: f64, channels: usize, frames: usize) -> f64 {
+    let ratio = channels as f64 / frames.max(1) as f64;
+    noise_var * (1.0 + ratio.sqrt()).powi(2)
+}
+
 /// Picks `m` from the request and the spectrum.
-fn choose_m(components: Components, eigenvalues: &[f64], rank: usize) -> Result<usize, FitError> {
+fn choose_m(
+    components: Components,
+    eigenvalues: &[f64],
+    rank: usize,
+    frames: usize,
+) -> Result<usize, FitError> {
     match components {
+        Components::VarianceAboveNoise { target, noise_var } => {
+            let by_share = choose_m(
+                Components::VarianceTarget(target),
+                eigenvalues,
+                rank,
+                frames,
+            )?;
+            let edge = noise_edge(noise_var, eigenvalues.len(), frames);
+            let signal = eigenvalues.iter().take(rank).filter(|&&l| l > edge).count();
+            Ok(by_share.min(signal).max(1))
+        }
         Components::Fixed(m) if m > rank => Err(FitError::ComponentsExceedRank { m, rank }),
         Components::Fixed(m) => Ok(m),
         Components::VarianceTarget(target) => {
