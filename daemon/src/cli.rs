@@ -18,7 +18,16 @@ pub struct Cli {
 pub enum Command {
     /// Write a synthetic paired session (takes, ground truth, session.toml, regions.toml).
     #[command(after_help = "Examples:\n  emoshift synth --out session\n  \
-        emoshift synth --out s2 --seed 7 --sentences 4 --emotions neutral,sad,angry --format trc")]
+        emoshift synth --out s2 --seed 7 --sentences 4 --emotions neutral,sad,angry --format trc\n  \
+        emoshift synth --out s3 --emotion-dims 2 --emotions neutral,happy,sad,angry\n  \
+        emoshift synth --out s4 --emotions neutral,happy,calm --point calm=0.3,-0.4 --point happy=1,0.2\n\n\
+        Emotion space: each emotion is a point, one level per emotion direction (1: smile + / \
+        frown -, 2: brow knit + lip press, 3: inner brow raise + mouth corners down). Default \
+        points: k=1 neutral 0, happy 1, frustrated -1; k=2 neutral (0,0), happy (1,0), frustrated \
+        (-1,0.3), angry (-0.2,1), sad (-0.6,-0.8); k=3 the same with a third coordinate 0, except \
+        sad (-0.3,-0.2,1), plus surprised (0.2,-1,0) and fear (-0.3,0.6,0.9). Other names get \
+        spare points at least 0.5 from every other point. The truth (truth/mixing.json) records \
+        every point.")]
     Synth(SynthArgs),
     /// Show a take's labels, rate, frame range, units and missing samples per marker.
     #[command(after_help = "Examples:\n  emoshift info take.c3d\n  emoshift info take.trc --json")]
@@ -96,6 +105,13 @@ pub struct SynthArgs {
         default_value = "neutral,happy,frustrated"
     )]
     pub emotions: Vec<String>,
+    /// Number of emotion directions, 1 to 3 (default: the coordinate count of --point, else 1).
+    #[arg(long, value_name = "K")]
+    pub emotion_dims: Option<usize>,
+    /// An explicit point for an emotion of --emotions: one level per emotion direction.
+    /// Repeat the flag, or separate points with ';'.
+    #[arg(long = "point", value_name = "NAME=X[,Y[,Z]]", value_delimiter = ';')]
+    pub points: Vec<replay::synth::EmotionPoint>,
     /// Frame rate in Hz.
     #[arg(long, default_value_t = 120.0)]
     pub rate: f64,

@@ -53,6 +53,50 @@ fn synth_output_reads_back_identically_in_all_three_formats() {
 }
 
 #[test]
+fn synth_writes_an_emotion_space_with_explicit_points() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("space");
+    let printed = ok(&[
+        "synth",
+        "--out",
+        p(&out),
+        "--sentences",
+        "1",
+        "--emotions",
+        "neutral,sad,angry,calm",
+        "--point",
+        "calm=0.3,-0.4",
+    ]);
+    assert!(printed.contains("sad (-0.6, -0.8)"), "{printed}");
+    let truth = replay::synth::load_truth(&out).expect("truth loads");
+    let m = &truth.mixing;
+    assert_eq!(
+        m.emotion_columns(),
+        vec![4, 5],
+        "two directions from the point"
+    );
+    assert_eq!(m.point_of("calm"), Some(vec![0.3, -0.4]));
+    assert_eq!(m.point_of("angry"), Some(vec![-0.2, 1.0]));
+    assert_eq!(truth.takes.len(), 4);
+    let base = ["synth", "--out", p(&out), "--sentences", "1"];
+    for (extra, needle) in [
+        (&["--emotion-dims", "4"][..], "got 4"),
+        (
+            &["--emotion-dims", "3", "--point", "happy=1,0"][..],
+            "has 2 coordinates",
+        ),
+        (&["--point", "joy=1"][..], "\"joy\""),
+        (&["--point", "happy=1,x"][..], "happy=1,x"),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra).copied().collect();
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{err:?} should name {needle:?}");
+    }
+}
+
+#[test]
 fn bad_input_gets_one_clear_line_and_exit_code_1() {
     let dir = tempfile::tempdir().expect("temp dir");
     let d = dir.path();

@@ -1,7 +1,8 @@
 //! `emoshift synth`: write a paired synthetic session.
 
 use anyhow::{Context, Result};
-use replay::synth::{write_session, Layout, SynthParams};
+use replay::synth::space::emotion_points;
+use replay::synth::{write_session, Layout, SynthParams, DEFAULT_EMOTION_DIMS};
 
 use crate::cli::SynthArgs;
 use crate::exit::UsageError;
@@ -24,6 +25,11 @@ pub(crate) fn run(args: &SynthArgs) -> Result<()> {
         seed: args.seed,
         sentences: args.sentences,
         emotions: args.emotions.clone(),
+        emotion_dims: args
+            .emotion_dims
+            .or_else(|| args.points.first().map(|p| p.point.len()))
+            .unwrap_or(DEFAULT_EMOTION_DIMS),
+        emotion_points: args.points.clone(),
         rate_hz: args.rate,
         head_motion: args.head_motion,
         layout: Layout {
@@ -45,6 +51,29 @@ pub(crate) fn run(args: &SynthArgs) -> Result<()> {
         params.layout.describe(),
         summary.dir.display()
     );
+    crate::out!("emotion points: {}", describe_points(&params));
     crate::out!("manifest: {}", summary.manifest.display());
     Ok(())
+}
+
+/// `neutral (0, 0), happy (1, 0), ...`: each emotion's point, as the truth records it.
+fn describe_points(params: &SynthParams) -> String {
+    let points = emotion_points(
+        &params.emotions,
+        params.emotion_dims,
+        &params.emotion_points,
+    );
+    let described: Vec<String> = params
+        .emotions
+        .iter()
+        .zip(points)
+        .map(|(e, p)| {
+            let coords: Vec<String> = p.iter().map(f64::to_string).collect();
+            match coords.as_slice() {
+                [one] => format!("{e} {one}"),
+                _ => format!("{e} ({})", coords.join(", ")),
+            }
+        })
+        .collect();
+    described.join(", ")
 }

@@ -1,10 +1,11 @@
 //! A deterministic synthetic talking face with known sources, for testing the emotion method.
 //!
 //! A [`Synth`] holds a 109-marker face ([`geometry`]), a corpus of sentences ([`speech`]), the
-//! emotion levels ([`sources`]) and the true linear mixing matrix ([`mixing`]). Each take is
-//! sentence x emotion with its own smooth timing warp ([`warp`]); rendering ([`render`]) mixes
-//! the sources onto the rest face, applies optional rigid head motion and 0.2 mm noise. The
-//! ground truth ([`truth`]) travels beside the takes as JSON.
+//! emotion space (each emotion a point on `k` emotion directions, [`space`]) and the true linear
+//! mixing matrix ([`mixing`], columns in [`SourceLayout`] order, emotion fields in
+//! [`expressions`]). Each take is sentence x emotion with its own smooth timing warp ([`warp`]);
+//! rendering ([`render`]) mixes the sources onto the rest face, applies optional rigid head
+//! motion and 0.2 mm noise. The ground truth ([`truth`]) travels beside the takes as JSON.
 //!
 //! ```
 //! use replay::synth::{Synth, SynthParams};
@@ -17,8 +18,31 @@
 //! # Ok::<(), replay::synth::SynthError>(())
 //! ```
 //!
-//! Same parameters, same bits: every random draw comes from its own seeded ChaCha8 stream.
+//! Two or three emotion directions, and a blend rendered at the timing of a real take:
+//!
+//! ```
+//! use replay::synth::{EmotionPoint, Synth, SynthParams};
+//! let synth = Synth::new(SynthParams {
+//!     sentences: 1,
+//!     emotion_dims: 2,
+//!     emotions: vec!["neutral".into(), "sad".into(), "angry".into(), "calm".into()],
+//!     emotion_points: vec!["calm=0.3,-0.4".parse::<EmotionPoint>()?],
+//!     ..SynthParams::default()
+//! })?;
+//! assert_eq!(synth.point_of("sad")?, &[-0.6, -0.8]);
+//! let neutral = synth.take_spec(0, "neutral")?;
+//! let blend = synth.blend(&[("sad", 0.5), ("angry", 0.5)])?;
+//! let blended = synth.render_take(&neutral.clone().with_levels(blend))?;
+//! assert_eq!(blended.take.n_frames(), synth.render_take(&neutral)?.take.n_frames());
+//! # Ok::<(), replay::synth::SynthError>(())
+//! ```
+//!
+//! Same parameters, same bits: every random draw comes from its own seeded ChaCha8 stream, and
+//! with one emotion direction the sessions are those of the one-source generator, bit for bit.
 
+pub mod columns;
+mod error;
+pub mod expressions;
 pub mod geometry;
 pub mod layout;
 pub mod mixing;
@@ -26,17 +50,18 @@ pub mod render;
 mod seeds;
 pub mod session_io;
 pub mod sources;
+pub mod space;
 pub mod speech;
 pub mod truth;
 pub mod warp;
 
-use std::path::PathBuf;
-
+pub use columns::{SourceInfo, SourceLayout, MAX_EMOTION_DIMS};
+pub use error::SynthError;
 pub use geometry::{FaceGeometry, Region};
 pub use layout::{Layout, MarkerSet, Naming, RigidMarkers};
-pub use mixing::{SourceInfo, SOURCE_COUNT};
 pub use render::{RenderedTake, TakeSpec, NOISE_STD_MM};
 pub use session_io::{generate_session, write_session, SessionSummary, SynthSession};
+pub use space::EmotionPoint;
 pub use speech::Sentence;
 pub use truth::{load_truth, MixingTruth, SessionTruth, TakeTruth};
 pub use warp::Warp;
@@ -49,79 +74,8 @@ pub const DEFAULT_RATE_HZ: f64 = 120.0;
 pub const DEFAULT_SENTENCES: usize = 8;
 /// Default emotions.
 pub const DEFAULT_EMOTIONS: [&str; 3] = ["neutral", "happy", "frustrated"];
-
-/// Why the generator cannot run.
-#[derive(Debug, thiserror::Error)]
-pub enum SynthError {
-    /// The frame rate is not positive and finite.
-    #[error("rate must be positive and finite, got {0}")]
-    BadRate(f64),
-    /// No sentences were requested.
-    #[error("need at least one sentence, got 0")]
-    NoSentences,
-    /// No emotions were given.
-    #[error("need at least one emotion")]
-    NoEmotions,
-    /// An emotion name is empty or unusable in a file name.
-    #[error("emotion name {0:?} must be non-empty and use only letters, digits, '-' or '_'")]
-    BadEmotionName(String),
-    /// An emotion is listed twice.
-    #[error("emotion {0:?} is listed twice")]
-    DuplicateEmotion(String),
-    /// An emotion not in the session was asked for.
-    #[error("unknown emotion {0:?}")]
-    UnknownEmotion(String),
-    /// A sentence index beyond the corpus.
-    #[error("sentence index {sentence} out of range (session has {count})")]
-    SentenceOutOfRange {
-        /// The index asked for.
-        sentence: usize,
-        /// Number of sentences.
-        count: usize,
-    },
-    /// A warp that does not span its sentence.
-    #[error(
-        "warp spans {warp_s} s of canonical time but sentence {sentence} lasts {sentence_s} s"
-    )]
-    WarpMismatch {
-        /// Sentence id.
-        sentence: String,
-        /// Canonical duration covered by the warp.
-        warp_s: f64,
-        /// Canonical duration of the sentence.
-        sentence_s: f64,
-    },
-    /// A rendered take broke a take invariant (a bug, reported rather than panicking).
-    #[error(transparent)]
-    Take(#[from] crate::TakeError),
-    /// Writing a take file failed.
-    #[error("cannot write take {path:?}: {source}")]
-    Write {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: crate::WriteError,
-    },
-    /// A file or folder could not be read or written.
-    #[error("cannot access {path:?}: {source}")]
-    Io {
-        /// The path.
-        path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
-    },
-    /// A truth file is not valid JSON for its type.
-    #[error("bad truth json {path:?}: {source}")]
-    Json {
-        /// The file.
-        path: PathBuf,
-        /// The JSON error.
-        source: serde_json::Error,
-    },
-    /// The manifest or region map is invalid.
-    #[error(transparent)]
-    Session(#[from] crate::session::SessionError),
-}
+/// Default number of emotion directions: one, the smile/frown line.
+pub const DEFAULT_EMOTION_DIMS: usize = 1;
 
 /// The generator's knobs (exactly those of `emoshift synth`).
 #[derive(Debug, Clone, PartialEq)]
@@ -132,6 +86,12 @@ pub struct SynthParams {
     pub sentences: usize,
     /// Emotion names (non-empty, unique, letters/digits/`-`/`_`).
     pub emotions: Vec<String>,
+    /// Number of emotion directions (columns of the mixing matrix), 1 to
+    /// [`MAX_EMOTION_DIMS`].
+    pub emotion_dims: usize,
+    /// Explicit points for some of the emotions (each with `emotion_dims` coordinates); the
+    /// others get their known or spare points ([`space`]).
+    pub emotion_points: Vec<EmotionPoint>,
     /// Frame rate, Hz.
     pub rate_hz: f64,
     /// Whether to add small rigid head motion.
@@ -146,6 +106,8 @@ impl Default for SynthParams {
             seed: 0,
             sentences: DEFAULT_SENTENCES,
             emotions: DEFAULT_EMOTIONS.iter().map(|s| s.to_string()).collect(),
+            emotion_dims: DEFAULT_EMOTION_DIMS,
+            emotion_points: Vec::new(),
             rate_hz: DEFAULT_RATE_HZ,
             head_motion: false,
             layout: Layout::default(),
@@ -157,7 +119,8 @@ impl SynthParams {
     /// Checks the knobs.
     ///
     /// # Errors
-    /// The first bad knob: rate, sentence count, emotion list.
+    /// The first bad knob: rate, sentence count, emotion list, emotion directions, explicit
+    /// points.
     pub fn validate(&self) -> Result<(), SynthError> {
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
             return Err(SynthError::BadRate(self.rate_hz));
@@ -165,6 +128,12 @@ impl SynthParams {
         if self.sentences == 0 {
             return Err(SynthError::NoSentences);
         }
+        self.validate_emotions()?;
+        SourceLayout::new(self.emotion_dims)?;
+        self.validate_points()
+    }
+
+    fn validate_emotions(&self) -> Result<(), SynthError> {
         if self.emotions.is_empty() {
             return Err(SynthError::NoEmotions);
         }
@@ -181,17 +150,43 @@ impl SynthParams {
         }
         Ok(())
     }
+
+    fn validate_points(&self) -> Result<(), SynthError> {
+        for (i, p) in self.emotion_points.iter().enumerate() {
+            if !self.emotions.contains(&p.name) {
+                return Err(SynthError::UnlistedPoint(p.name.clone()));
+            }
+            if self.emotion_points[..i].iter().any(|q| q.name == p.name) {
+                return Err(SynthError::DuplicatePoint(p.name.clone()));
+            }
+            if p.point.len() != self.emotion_dims {
+                return Err(SynthError::PointDims {
+                    emotion: p.name.clone(),
+                    expected: self.emotion_dims,
+                    got: p.point.len(),
+                });
+            }
+            if let Some(&value) = p.point.iter().find(|v| !v.is_finite()) {
+                return Err(SynthError::NonFinitePoint {
+                    emotion: p.name.clone(),
+                    value,
+                });
+            }
+        }
+        Ok(())
+    }
 }
 
-/// A configured generator: face, sentences, emotion levels and mixing matrix.
+/// A configured generator: face, sentences, emotion points and mixing matrix.
 #[derive(Debug, Clone)]
 pub struct Synth {
     params: SynthParams,
+    columns: SourceLayout,
     face: FaceGeometry,
     rest: Vec<f64>,
     mixing: Vec<f64>,
     sentences: Vec<Sentence>,
-    levels: Vec<f64>,
+    points: Vec<Vec<f64>>,
 }
 
 impl Synth {
@@ -201,14 +196,20 @@ impl Synth {
     /// [`SynthParams::validate`] failures.
     pub fn new(params: SynthParams) -> Result<Synth, SynthError> {
         params.validate()?;
+        let columns = SourceLayout::new(params.emotion_dims)?;
         let face = params.layout.face(params.seed);
         let sentences = (0..params.sentences)
             .map(|i| Sentence::generate(params.seed, i, params.sentences))
             .collect();
         Ok(Synth {
             rest: face.rest_flat(),
-            mixing: mixing::mixing_matrix(&face, params.layout.soft_nose()),
-            levels: sources::emotion_levels(&params.emotions),
+            mixing: mixing::mixing_matrix(&face, params.layout.soft_nose(), columns),
+            points: space::emotion_points(
+                &params.emotions,
+                params.emotion_dims,
+                &params.emotion_points,
+            ),
+            columns,
             face,
             sentences,
             params,
@@ -218,6 +219,11 @@ impl Synth {
     /// The parameters.
     pub fn params(&self) -> &SynthParams {
         &self.params
+    }
+
+    /// Which column holds which source.
+    pub fn source_layout(&self) -> SourceLayout {
+        self.columns
     }
 
     /// The marker set.
@@ -230,7 +236,7 @@ impl Synth {
         &self.rest
     }
 
-    /// Mixing matrix, channels x [`SOURCE_COUNT`], row-major, mm per source unit.
+    /// Mixing matrix, channels x [`SourceLayout::count`], row-major, mm per source unit.
     pub fn mixing(&self) -> &[f64] {
         &self.mixing
     }
@@ -240,13 +246,37 @@ impl Synth {
         &self.sentences
     }
 
-    /// Base level of an emotion of this session.
+    /// Base level of an emotion on the first emotion direction (its whole level with one
+    /// direction).
     ///
     /// # Errors
     /// [`SynthError::UnknownEmotion`].
     pub fn level_of(&self, emotion: &str) -> Result<f64, SynthError> {
+        Ok(self.point_of(emotion)?[0])
+    }
+
+    /// Base point of an emotion: its level on each emotion direction, before the per-sentence
+    /// intensity.
+    ///
+    /// # Errors
+    /// [`SynthError::UnknownEmotion`].
+    pub fn point_of(&self, emotion: &str) -> Result<&[f64], SynthError> {
         let i = self.emotion_index(emotion)?;
-        Ok(self.levels[i])
+        Ok(&self.points[i])
+    }
+
+    /// The level vector of a blend of this session's emotions, `Σ weight · point`; e.g.
+    /// `[("sad", 0.5), ("angry", 0.5)]`. Render it with [`TakeSpec::with_levels`].
+    ///
+    /// # Errors
+    /// [`SynthError::UnknownEmotion`] for a name not in the session.
+    pub fn blend(&self, weights: &[(&str, f64)]) -> Result<Vec<f64>, SynthError> {
+        let parts = weights
+            .iter()
+            .map(|(name, w)| Ok((self.point_of(name)?, *w)))
+            .collect::<Result<Vec<_>, SynthError>>()?;
+        Ok(space::blend(self.columns.emotion_dims(), parts)
+            .expect("every point of the session has one level per direction"))
     }
 
     fn emotion_index(&self, emotion: &str) -> Result<usize, SynthError> {
@@ -263,7 +293,7 @@ impl Synth {
         format!("{id}_{emotion}")
     }
 
-    /// The session's take of `sentence` in `emotion`: its level (base x per-sentence
+    /// The session's take of `sentence` in `emotion`: its levels (base point x per-sentence
     /// intensity), its own random warp and its own seed.
     ///
     /// # Errors
@@ -276,7 +306,9 @@ impl Synth {
                 sentence,
                 count: self.sentences.len(),
             })?;
-        let base = self.level_of(emotion)?;
+        let point = self.point_of(emotion)?;
+        let intensity = sources::sentence_intensity(self.params.seed, sentence, emotion);
+        let emotion_levels = point.iter().map(|p| p * intensity).collect();
         let seed = sub_seed(
             self.params.seed,
             Stream::Take,
@@ -287,7 +319,7 @@ impl Synth {
         Ok(TakeSpec {
             sentence,
             emotion: emotion.to_string(),
-            emotion_level: base * sources::sentence_intensity(self.params.seed, sentence, emotion),
+            emotion_levels,
             warp: Warp::random(&mut rng, s.duration_s, self.params.rate_hz),
             seed,
             noise: true,
@@ -297,7 +329,9 @@ impl Synth {
     /// Renders a take.
     ///
     /// # Errors
-    /// [`SynthError::SentenceOutOfRange`] or [`SynthError::WarpMismatch`].
+    /// [`SynthError::SentenceOutOfRange`], [`SynthError::WarpMismatch`], or
+    /// [`SynthError::LevelDims`] / [`SynthError::NonFiniteLevel`] for a level vector that is
+    /// not one finite level per emotion direction.
     pub fn render_take(&self, spec: &TakeSpec) -> Result<RenderedTake, SynthError> {
         render::render(self, spec)
     }

@@ -3,10 +3,9 @@
 
 use rand_distr::{Distribution, Normal};
 
-use super::mixing::{BLINK, BROW_RAISE, EMOTION, HEAD, HEAD_PIVOT, SOURCE_COUNT};
+use super::mixing::HEAD_PIVOT;
 use super::seeds::{sub_rng, Stream};
-use super::sources::{blink_at, blink_events, emotion_drift, HeadMotion};
-use super::speech::SPEECH_SOURCES;
+use super::sources::{blink_at, blink_events, emotion_drifts, HeadMotion};
 use super::truth::TakeTruth;
 use super::warp::Warp;
 use super::{Synth, SynthError};
@@ -17,15 +16,17 @@ pub const NOISE_STD_MM: f64 = 0.2;
 
 /// Everything that decides one take. Build it with [`Synth::take_spec`]; to render sentence S
 /// in emotion B with the timing of S's take in emotion A, use
-/// `synth.take_spec(s, "B")?.with_timing_of(&spec_a)`.
+/// `synth.take_spec(s, "B")?.with_timing_of(&spec_a)`; to render S's take in A at any level
+/// vector (a blend, a shifted point) with A's timing, use `spec_a.with_levels(levels)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TakeSpec {
     /// 0-based sentence index.
     pub sentence: usize,
     /// Emotion name (labels the take; the level below is what is rendered).
     pub emotion: String,
-    /// Emotion level rendered: base level x per-sentence intensity.
-    pub emotion_level: f64,
+    /// Level rendered on each emotion direction: the emotion's base point x per-sentence
+    /// intensity (one level per direction; the emotion sources are these plus a slow drift).
+    pub emotion_levels: Vec<f64>,
     /// Canonical time of each frame; decides the frame count.
     pub warp: Warp,
     /// Seed of the take's real-time randomness: emotion drift, blinks, head motion, noise.
@@ -40,6 +41,15 @@ impl TakeSpec {
     pub fn with_timing_of(mut self, other: &TakeSpec) -> TakeSpec {
         self.warp = other.warp.clone();
         self.seed = other.seed;
+        self
+    }
+
+    /// This spec rendered at `levels` (one per emotion direction) instead of its emotion's:
+    /// same timing, drift, blinks, head motion and noise, so two renders differ only by the
+    /// emotion columns of the mixing matrix times the level change. The take keeps its
+    /// emotion name; set [`TakeSpec::emotion`] to relabel it.
+    pub fn with_levels(mut self, levels: Vec<f64>) -> TakeSpec {
+        self.emotion_levels = levels;
         self
     }
 }
@@ -57,7 +67,9 @@ pub struct RenderedTake {
 ///
 /// # Errors
 /// [`SynthError::SentenceOutOfRange`] for a bad sentence index, [`SynthError::WarpMismatch`]
-/// when the warp does not span the sentence's canonical duration.
+/// when the warp does not span the sentence's canonical duration, [`SynthError::LevelDims`] or
+/// [`SynthError::NonFiniteLevel`] for a level vector that is not one finite level per emotion
+/// direction.
 pub(crate) fn render(synth: &Synth, spec: &TakeSpec) -> Result<RenderedTake, SynthError> {
     let sentence = synth
         .sentences()
@@ -66,6 +78,7 @@ pub(crate) fn render(synth: &Synth, spec: &TakeSpec) -> Result<RenderedTake, Syn
             sentence: spec.sentence,
             count: synth.sentences().len(),
         })?;
+    check_levels(synth, &spec.emotion_levels)?;
     let end = spec.warp.canonical_duration_s();
     let ok = spec.warp.n_frames() >= 2 && (end - sentence.duration_s).abs() < 1e-6;
     if !ok {
@@ -77,7 +90,8 @@ pub(crate) fn render(synth: &Synth, spec: &TakeSpec) -> Result<RenderedTake, Syn
     }
     let rate = synth.params().rate_hz;
     let n = spec.warp.n_frames();
-    let drift = emotion_drift(spec.seed);
+    let cols = synth.source_layout();
+    let drifts = emotion_drifts(spec.seed, cols.emotion_dims());
     let blinks = blink_events(spec.seed, (n - 1) as f64 / rate);
     let head = synth
         .params()
@@ -86,13 +100,15 @@ pub(crate) fn render(synth: &Synth, spec: &TakeSpec) -> Result<RenderedTake, Syn
     let sources: Vec<Vec<f64>> = (0..n)
         .map(|f| {
             let (t, tau) = (f as f64 / rate, spec.warp.canonical_s[f]);
-            let mut s = vec![0.0; SOURCE_COUNT];
-            s[..SPEECH_SOURCES].copy_from_slice(&sentence.speech_at(tau));
-            s[EMOTION] = spec.emotion_level + drift.at(t);
-            s[BROW_RAISE] = sentence.brow_at(tau);
-            s[BLINK] = blink_at(&blinks, t);
+            let mut s = vec![0.0; cols.count()];
+            s[..cols.speech_count()].copy_from_slice(&sentence.speech_at(tau));
+            for (d, (level, drift)) in spec.emotion_levels.iter().zip(&drifts).enumerate() {
+                s[cols.emotion(d)] = level + drift.at(t);
+            }
+            s[cols.brow_raise()] = sentence.brow_at(tau);
+            s[cols.blink()] = blink_at(&blinks, t);
             if let Some(h) = &head {
-                s[HEAD..].copy_from_slice(&h.at(t));
+                s[cols.head()..].copy_from_slice(&h.at(t));
             }
             s
         })
@@ -103,7 +119,8 @@ pub(crate) fn render(synth: &Synth, spec: &TakeSpec) -> Result<RenderedTake, Syn
         sentence: sentence.id.clone(),
         sentence_index: spec.sentence,
         emotion: spec.emotion.clone(),
-        emotion_level: spec.emotion_level,
+        emotion_level: spec.emotion_levels[0],
+        emotion_levels: spec.emotion_levels.clone(),
         seed: spec.seed,
         rate_hz: rate,
         warp: spec.warp.canonical_s.clone(),
@@ -113,6 +130,21 @@ pub(crate) fn render(synth: &Synth, spec: &TakeSpec) -> Result<RenderedTake, Syn
         segments: sentence.segments.clone(),
     };
     Ok(RenderedTake { take, truth })
+}
+
+/// One finite level per emotion direction.
+fn check_levels(synth: &Synth, levels: &[f64]) -> Result<(), SynthError> {
+    let expected = synth.source_layout().emotion_dims();
+    if levels.len() != expected {
+        return Err(SynthError::LevelDims {
+            expected,
+            got: levels.len(),
+        });
+    }
+    match levels.iter().find(|v| !v.is_finite()) {
+        Some(&v) => Err(SynthError::NonFiniteLevel(v)),
+        None => Ok(()),
+    }
 }
 
 /// Mixes sources into marker positions: rest + facial columns · sources, then the exact rigid
@@ -129,17 +161,18 @@ fn mix(synth: &Synth, sources: &[Vec<f64>], spec: &TakeSpec) -> Result<Take, Syn
     let missing = vec![false; markers];
     let mut xyz = vec![0.0f32; channels];
     let mut face = vec![0.0f64; channels];
+    let (count, head) = (synth.source_layout().count(), synth.source_layout().head());
     for s in sources {
         for (c, out) in face.iter_mut().enumerate() {
-            let row = &m[c * SOURCE_COUNT..c * SOURCE_COUNT + HEAD];
-            *out = rest[c] + row.iter().zip(&s[..HEAD]).map(|(a, v)| a * v).sum::<f64>();
+            let row = &m[c * count..c * count + head];
+            *out = rest[c] + row.iter().zip(&s[..head]).map(|(a, v)| a * v).sum::<f64>();
         }
-        let rot = rotation(s[HEAD], s[HEAD + 1], s[HEAD + 2]);
+        let rot = rotation(s[head], s[head + 1], s[head + 2]);
         for k in 0..markers {
             let p: [f64; 3] = std::array::from_fn(|a| face[k * 3 + a] - HEAD_PIVOT[a]);
             for a in 0..3 {
                 let moved = rot[a][0] * p[0] + rot[a][1] * p[1] + rot[a][2] * p[2];
-                let mut v = moved + HEAD_PIVOT[a] + s[HEAD + 3 + a];
+                let mut v = moved + HEAD_PIVOT[a] + s[head + 3 + a];
                 if spec.noise {
                     v += normal.sample(&mut noise_rng);
                 }

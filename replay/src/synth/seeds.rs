@@ -27,6 +27,9 @@ pub(crate) enum Stream {
     Noise = 8,
     /// Marker placement of a jittered layout.
     Layout = 9,
+    /// Emotion drift of a take on emotion directions after the first; keyed by take seed and
+    /// direction (the first keeps [`Stream::Drift`]).
+    DirectionDrift = 10,
 }
 
 /// SplitMix64 finaliser: a cheap, well-mixed bijection on u64.

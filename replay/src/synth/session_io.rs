@@ -4,10 +4,10 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use super::mixing::{source_infos, HEAD_PIVOT};
+use super::mixing::HEAD_PIVOT;
 use super::render::NOISE_STD_MM;
 use super::truth::{write_truth, EmotionLevel, MixingTruth, SessionTruth};
-use super::{FaceGeometry, RenderedTake, Synth, SynthError, SynthParams, SOURCE_COUNT};
+use super::{FaceGeometry, RenderedTake, Synth, SynthError, SynthParams};
 use crate::session::{Regions, Session, SessionTake, REGIONS_FILE, SESSION_FILE};
 use crate::{Format, Take};
 
@@ -42,16 +42,17 @@ pub struct SessionSummary {
 }
 
 impl Synth {
-    /// The session-wide truth: labels, sources, mixing matrix, rest shape, regions, levels.
+    /// The session-wide truth: labels, sources, mixing matrix, rest shape, regions, points.
     pub fn mixing_truth(&self) -> MixingTruth {
         let face = self.face();
         let regions = face.region_labels();
+        let cols = self.source_layout();
         MixingTruth {
             labels: face.labels(),
-            sources: source_infos(),
+            sources: cols.source_infos(),
             matrix: self
                 .mixing()
-                .chunks(SOURCE_COUNT)
+                .chunks(cols.count())
                 .map(<[f64]>::to_vec)
                 .collect(),
             rest: self.rest().to_vec(),
@@ -60,11 +61,16 @@ impl Synth {
                 .params()
                 .emotions
                 .iter()
-                .map(|e| EmotionLevel {
-                    name: e.clone(),
-                    level: self.level_of(e).expect("session emotions have levels"),
+                .map(|e| {
+                    let point = self.point_of(e).expect("session emotions have points");
+                    EmotionLevel {
+                        name: e.clone(),
+                        level: point[0],
+                        point: point.to_vec(),
+                    }
                 })
                 .collect(),
+            emotion_columns: cols.emotions().collect(),
             rate_hz: self.params().rate_hz,
             seed: self.params().seed,
             noise_std_mm: NOISE_STD_MM,

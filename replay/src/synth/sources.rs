@@ -1,4 +1,5 @@
-//! The non-speech sources: emotion (level, per-sentence intensity, slow drift), blinks and rigid
+//! The non-speech sources: emotion (level, per-sentence intensity, slow drift per direction;
+//! the points themselves live in [`space`](super::space)), blinks and rigid
 //! head motion. Emotion and blinks are independent of the sentence's content; brow emphasis
 //! lives with the sentence in [`speech`](super::speech).
 
@@ -8,43 +9,27 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use super::seeds::{name_key, sub_rng, Stream};
+use super::space::emotion_points;
 
-/// Fixed levels of the well-known emotions; the emotion source is positive for a smile.
-const KNOWN_LEVELS: [(&str, f64); 3] = [("neutral", 0.0), ("happy", 1.0), ("frustrated", -1.0)];
-/// Levels handed out, in order, to names not in [`KNOWN_LEVELS`] (skipping any already used).
-const SPARE_LEVELS: [f64; 8] = [0.5, -0.5, 1.5, -1.5, 2.0, -2.0, 2.5, -2.5];
 /// Relative spread of the emotion intensity between sentences (±).
 pub const INTENSITY_SPREAD: f64 = 0.15;
-/// Peak amplitude of the slow within-take emotion drift (source units).
+/// Peak amplitude of the slow within-take emotion drift (source units), on each direction.
 pub const DRIFT_AMPLITUDE: f64 = 0.1;
 
-/// The base level of each emotion, in list order: neutral 0, happy +1, frustrated -1; other
-/// names get 0.5, -0.5, 1.5, -1.5, 2, -2, ... in the order they appear (skipping levels a known
-/// name already holds), then keep stepping by 0.5 outwards.
+/// The base level of each emotion on a single emotion direction, in list order: neutral 0,
+/// happy +1, frustrated -1; other names get 0.5, -0.5, 1.5, -1.5, 2, -2, ... in the order they
+/// appear (skipping levels a known name already holds), then keep stepping by 0.5 outwards.
+/// The one-direction case of [`emotion_points`].
 pub fn emotion_levels(names: &[String]) -> Vec<f64> {
-    let known = |n: &str| KNOWN_LEVELS.iter().find(|(k, _)| *k == n).map(|(_, l)| *l);
-    let mut used: Vec<f64> = names.iter().filter_map(|n| known(n)).collect();
-    let mut spare = SPARE_LEVELS
-        .iter()
-        .copied()
-        .chain((6..).flat_map(|k| [f64::from(k) * 0.5, -f64::from(k) * 0.5]));
-    names
-        .iter()
-        .map(|n| {
-            known(n).unwrap_or_else(|| {
-                let level = spare
-                    .by_ref()
-                    .find(|l| !used.contains(l))
-                    .expect("the spare level sequence is infinite");
-                used.push(level);
-                level
-            })
-        })
+    emotion_points(names, 1, &[])
+        .into_iter()
+        .map(|p| p[0])
         .collect()
 }
 
 /// Intensity factor of an emotion in one sentence, in `1 ± INTENSITY_SPREAD`: the same
-/// emotion is acted a little more or less strongly from sentence to sentence.
+/// emotion is acted a little more or less strongly from sentence to sentence. It scales the
+/// emotion's whole point, so every direction of a take is scaled by the same factor.
 pub fn sentence_intensity(seed: u64, sentence: usize, emotion: &str) -> f64 {
     let mut rng = sub_rng(seed, Stream::Intensity, sentence as u64, name_key(emotion));
     1.0 + rng.random_range(-INTENSITY_SPREAD..INTENSITY_SPREAD)
@@ -81,10 +66,26 @@ impl Wobble {
     }
 }
 
-/// The emotion drift of a take (real time): periods of about 3 to 10 seconds.
+/// The emotion drift of a take (real time) on the first emotion direction: periods of about 3
+/// to 10 seconds.
 pub fn emotion_drift(take_seed: u64) -> Wobble {
     let mut rng = sub_rng(take_seed, Stream::Drift, 0, 0);
     Wobble::random(&mut rng, 2, DRIFT_AMPLITUDE, (0.1, 0.33))
+}
+
+/// The emotion drift of a take on each of `dims` directions, independent of each other: the
+/// first is [`emotion_drift`], the others come from their own streams, so adding directions
+/// never changes the first.
+pub fn emotion_drifts(take_seed: u64, dims: usize) -> Vec<Wobble> {
+    (0..dims)
+        .map(|d| {
+            if d == 0 {
+                return emotion_drift(take_seed);
+            }
+            let mut rng = sub_rng(take_seed, Stream::DirectionDrift, d as u64, 0);
+            Wobble::random(&mut rng, 2, DRIFT_AMPLITUDE, (0.1, 0.33))
+        })
+        .collect()
 }
 
 /// One blink, in real time.

@@ -7,8 +7,9 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::mixing::SourceInfo;
+use super::columns::SourceInfo;
 use super::sources::BlinkEvent;
+use super::space::blend;
 use super::speech::{BrowEvent, Segment};
 use super::SynthError;
 
@@ -17,13 +18,29 @@ pub const TRUTH_DIR: &str = "truth";
 /// File name of the session-wide truth.
 pub const MIXING_FILE: &str = "mixing.json";
 
-/// An emotion and its base level on the emotion source.
+/// An emotion and its base point in the emotion space.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EmotionLevel {
     /// Emotion name, e.g. `happy`.
     pub name: String,
-    /// Base level (before per-sentence intensity): neutral 0, happy 1, frustrated -1.
+    /// Base level on the first emotion direction (before per-sentence intensity): with one
+    /// direction neutral 0, happy 1, frustrated -1.
     pub level: f64,
+    /// Base level on every emotion direction (empty in truth written before emotion spaces
+    /// existed: read it with [`EmotionLevel::point`]).
+    #[serde(default)]
+    pub point: Vec<f64>,
+}
+
+impl EmotionLevel {
+    /// The base point; `[level]` for truth written with a single emotion source.
+    pub fn point(&self) -> Vec<f64> {
+        if self.point.is_empty() {
+            vec![self.level]
+        } else {
+            self.point.clone()
+        }
+    }
 }
 
 /// Session-wide truth: the linear model every take was rendered from.
@@ -45,8 +62,12 @@ pub struct MixingTruth {
     pub rest: Vec<f64>,
     /// Region name -> marker labels.
     pub regions: BTreeMap<String, Vec<String>>,
-    /// Emotions in session order with their base levels.
+    /// Emotions in session order with their base points.
     pub emotions: Vec<EmotionLevel>,
+    /// Columns of the emotion directions, in direction order (empty in truth written before
+    /// emotion spaces existed: read them with [`MixingTruth::emotion_columns`]).
+    #[serde(default)]
+    pub emotion_columns: Vec<usize>,
     /// Frame rate of every take.
     pub rate_hz: f64,
     /// Session seed.
@@ -80,12 +101,54 @@ impl MixingTruth {
         self.matrix.iter().map(|row| row[source]).collect()
     }
 
-    /// Base level of an emotion.
+    /// Base level of an emotion on the first emotion direction.
     pub fn level_of(&self, emotion: &str) -> Option<f64> {
         self.emotions
             .iter()
             .find(|e| e.name == emotion)
             .map(|e| e.level)
+    }
+
+    /// Base point of an emotion (one level per emotion direction).
+    pub fn point_of(&self, emotion: &str) -> Option<Vec<f64>> {
+        self.emotions
+            .iter()
+            .find(|e| e.name == emotion)
+            .map(EmotionLevel::point)
+    }
+
+    /// Columns of the emotion directions, in direction order.
+    pub fn emotion_columns(&self) -> Vec<usize> {
+        if self.emotion_columns.is_empty() {
+            self.role_indices("emotion")
+        } else {
+            self.emotion_columns.clone()
+        }
+    }
+
+    /// The level vector of a blend, `Σ weight · point`, e.g. `[("sad", 0.5), ("angry", 0.5)]`;
+    /// `None` for an emotion not in the session.
+    pub fn blend(&self, weights: &[(&str, f64)]) -> Option<Vec<f64>> {
+        let points = weights
+            .iter()
+            .map(|(name, w)| Some((self.point_of(name)?, *w)))
+            .collect::<Option<Vec<_>>>()?;
+        let dims = self.emotion_columns().len();
+        blend(dims, points.iter().map(|(p, w)| (p.as_slice(), *w)))
+    }
+
+    /// What a change `delta` of the emotion levels (one per direction) adds to every channel
+    /// of a frame, mm: the emotion columns of the matrix times `delta`. Two renders of a take
+    /// at the same timing differ by exactly this (plus f32 rounding). `None` when `delta` does
+    /// not have one level per direction.
+    pub fn emotion_displacement(&self, delta: &[f64]) -> Option<Vec<f64>> {
+        let cols = self.emotion_columns();
+        (cols.len() == delta.len()).then(|| {
+            self.matrix
+                .iter()
+                .map(|row| cols.iter().zip(delta).map(|(&c, d)| row[c] * d).sum())
+                .collect()
+        })
     }
 }
 
@@ -100,9 +163,14 @@ pub struct TakeTruth {
     pub sentence_index: usize,
     /// Emotion name; every frame of the take carries it.
     pub emotion: String,
-    /// Level actually rendered: base level x this sentence's intensity (the emotion source
-    /// is this plus a slow drift).
+    /// Level actually rendered on the first emotion direction: base level x this sentence's
+    /// intensity (the emotion source is this plus a slow drift).
     pub emotion_level: f64,
+    /// Level actually rendered on every emotion direction: base point x this sentence's
+    /// intensity (empty in truth written before emotion spaces existed: read it with
+    /// [`TakeTruth::levels`]).
+    #[serde(default)]
+    pub emotion_levels: Vec<f64>,
     /// Seed of the take's drift, blinks, head motion and noise.
     pub seed: u64,
     /// Frame rate.
@@ -123,6 +191,16 @@ impl TakeTruth {
     /// Number of frames.
     pub fn n_frames(&self) -> usize {
         self.sources.len()
+    }
+
+    /// Level rendered on every emotion direction; `[emotion_level]` for truth written with a
+    /// single emotion source.
+    pub fn levels(&self) -> Vec<f64> {
+        if self.emotion_levels.is_empty() {
+            vec![self.emotion_level]
+        } else {
+            self.emotion_levels.clone()
+        }
     }
 
     /// One source's time series.

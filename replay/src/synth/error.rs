@@ -1,0 +1,127 @@
+//! Why the generator cannot run: [`SynthError`].
+
+use std::path::PathBuf;
+
+/// Why the generator cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum SynthError {
+    /// The frame rate is not positive and finite.
+    #[error("rate must be positive and finite, got {0}")]
+    BadRate(f64),
+    /// No sentences were requested.
+    #[error("need at least one sentence, got 0")]
+    NoSentences,
+    /// No emotions were given.
+    #[error("need at least one emotion")]
+    NoEmotions,
+    /// An emotion name is empty or unusable in a file name.
+    #[error("emotion name {0:?} must be non-empty and use only letters, digits, '-' or '_'")]
+    BadEmotionName(String),
+    /// An emotion is listed twice.
+    #[error("emotion {0:?} is listed twice")]
+    DuplicateEmotion(String),
+    /// An emotion not in the session was asked for.
+    #[error("unknown emotion {0:?}")]
+    UnknownEmotion(String),
+    /// The emotion space has too few or too many directions.
+    #[error("emotion space must have 1 to {max} directions, got {dims}")]
+    EmotionDims {
+        /// Directions asked for.
+        dims: usize,
+        /// Emotion fields the generator defines.
+        max: usize,
+    },
+    /// An explicit emotion point does not parse.
+    #[error("emotion point {text:?} must be name=x[,y[,z]] with finite numbers")]
+    PointSyntax {
+        /// The text given.
+        text: String,
+    },
+    /// An explicit point whose coordinate count is not the number of emotion directions.
+    #[error(
+        "point of emotion {emotion:?} has {got} coordinates, the emotion space has {expected}"
+    )]
+    PointDims {
+        /// Emotion name.
+        emotion: String,
+        /// Emotion directions.
+        expected: usize,
+        /// Coordinates given.
+        got: usize,
+    },
+    /// An explicit point with a NaN or infinite coordinate.
+    #[error("point of emotion {emotion:?} has a non-finite coordinate {value}")]
+    NonFinitePoint {
+        /// Emotion name.
+        emotion: String,
+        /// The bad coordinate.
+        value: f64,
+    },
+    /// An explicit point for a name that is not in the emotion list.
+    #[error("point given for emotion {0:?}, which is not in the emotion list")]
+    UnlistedPoint(String),
+    /// Two explicit points for the same emotion.
+    #[error("emotion {0:?} is given two points")]
+    DuplicatePoint(String),
+    /// A take's level vector does not have one level per emotion direction.
+    #[error("take levels have {got} coordinates, the emotion space has {expected}")]
+    LevelDims {
+        /// Emotion directions.
+        expected: usize,
+        /// Levels given.
+        got: usize,
+    },
+    /// A take's level vector holds a NaN or infinite level.
+    #[error("take level {0} is not finite")]
+    NonFiniteLevel(f64),
+    /// A sentence index beyond the corpus.
+    #[error("sentence index {sentence} out of range (session has {count})")]
+    SentenceOutOfRange {
+        /// The index asked for.
+        sentence: usize,
+        /// Number of sentences.
+        count: usize,
+    },
+    /// A warp that does not span its sentence.
+    #[error(
+        "warp spans {warp_s} s of canonical time but sentence {sentence} lasts {sentence_s} s"
+    )]
+    WarpMismatch {
+        /// Sentence id.
+        sentence: String,
+        /// Canonical duration covered by the warp.
+        warp_s: f64,
+        /// Canonical duration of the sentence.
+        sentence_s: f64,
+    },
+    /// A rendered take broke a take invariant (a bug, reported rather than panicking).
+    #[error(transparent)]
+    Take(#[from] crate::TakeError),
+    /// Writing a take file failed.
+    #[error("cannot write take {path:?}: {source}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: crate::WriteError,
+    },
+    /// A file or folder could not be read or written.
+    #[error("cannot access {path:?}: {source}")]
+    Io {
+        /// The path.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A truth file is not valid JSON for its type.
+    #[error("bad truth json {path:?}: {source}")]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// The JSON error.
+        source: serde_json::Error,
+    },
+    /// The manifest or region map is invalid.
+    #[error(transparent)]
+    Session(#[from] crate::session::SessionError),
+}
