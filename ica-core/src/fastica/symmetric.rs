@@ -112,16 +112,7 @@ pub(crate) fn run(
             *gp = contrast.apply(col) * inv_t;
         }
         mul_add(&mut ws.b, 1.0, z, &ws.gy, 0.0);
-        for i in 0..m {
-            for j in 0..m {
-                w_new[(i, j)] = ws.b[(j, i)] * inv_t - ws.gp[i] * w[(i, j)];
-            }
-        }
-        if step.mu < 1.0 {
-            damp(&mut w_new, &w, step.mu);
-        }
-        decorrelate(&mut w_new);
-        delta = row_change(&w_new, &w);
+        delta = next_rotation(&w, &ws.b, &ws.gp, inv_t, step.mu, &mut w_new);
         std::mem::swap(&mut w, &mut w_new);
         if delta < tol {
             return Outcome {
@@ -139,6 +130,30 @@ pub(crate) fn run(
         converged: false,
         last_delta: delta,
     }
+}
+
+/// One symmetric step from the pass's sums: `next = B^T / T - diag(E g') W` (rows `i` of `W`,
+/// `B = Σ z g(y)^T`, `gp[i] = E g'(y_i)`), damped by `mu` when below 1, then decorrelated.
+/// Returns the change `max |1 - |diag(next W^T)||`, the step from a pass's sums, apart from how
+/// the sums are formed.
+pub(crate) fn next_rotation(
+    w: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    gp: &[f64],
+    inv_t: f64,
+    mu: f64,
+    next: &mut DMatrix<f64>,
+) -> f64 {
+    for i in 0..w.nrows() {
+        for j in 0..w.ncols() {
+            next[(i, j)] = b[(j, i)] * inv_t - gp[i] * w[(i, j)];
+        }
+    }
+    if mu < 1.0 {
+        damp(next, w, mu);
+    }
+    decorrelate(next);
+    row_change(next, w)
 }
 
 /// Replaces each row of `next` by the normalised blend `(1 - mu) w_i + mu n_i`, where `n_i` is

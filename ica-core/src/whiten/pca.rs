@@ -1,0 +1,172 @@
+//! The fitted PCA whitening transform, built from a covariance, apart from the scans that
+//! produce the covariance (so another source of statistics can share it).
+
+use nalgebra::DMatrix;
+
+use super::{eigen, Components, DEAD_CHANNEL_RELATIVE_VARIANCE, RANK_RELATIVE_EIGENVALUE};
+use crate::fit::FitError;
+
+/// PCA whitening fitted to the used frames, without the data: `z = Λ^{-1/2} Eᵀ (x - mean)` on
+/// the live channels.
+///
+/// Built inside [`super::whiten`] from the covariance of the used frames.
+#[derive(Debug, Clone)]
+pub struct Whitener {
+    /// Per-channel mean over the used frames (channels long; 0 for channels missing everywhere).
+    pub mean: Vec<f64>,
+    /// Channels with about zero variance or missing in every frame, ascending.
+    pub dead_channels: Vec<usize>,
+    /// The other channels, ascending: rows of `basis`.
+    pub live_channels: Vec<usize>,
+    /// Eigenvalues of the live covariance, largest first, negatives clamped to 0; the first `m`
+    /// are the Rayleigh quotients of the kept axes.
+    pub eigenvalues: Vec<f64>,
+    /// Numerical rank of the covariance.
+    pub rank: usize,
+    /// Share of the total variance explained by the kept components.
+    pub variance_kept: f64,
+    /// The kept principal axes, `live x m`, orthonormal columns, largest variance first.
+    pub basis: DMatrix<f64>,
+    /// Frames the statistics were taken over (no missing sample).
+    pub frames_used: usize,
+    /// Frames offered.
+    pub frames_total: usize,
+    /// `Λ^{-1/2} Eᵀ`, `m x live`.
+    pub(crate) rows: DMatrix<f64>,
+}
+
+/// What the PCA is computed from: the statistics of the used frames.
+pub(crate) struct Stats {
+    /// Per-channel mean (channels long).
+    pub mean: Vec<f64>,
+    /// Channels not missing everywhere, ascending.
+    pub seen: Vec<usize>,
+    /// Unbiased covariance of the `seen` channels.
+    pub cov: DMatrix<f64>,
+    /// Frames used.
+    pub frames_used: usize,
+    /// Frames offered.
+    pub frames_total: usize,
+}
+
+impl Whitener {
+    /// Components kept (`m`).
+    pub fn components(&self) -> usize {
+        self.basis.ncols()
+    }
+
+    /// Channels per frame.
+    pub fn channels(&self) -> usize {
+        self.mean.len()
+    }
+
+    /// The whitening matrix `Λ^{-1/2} Eᵀ`, `m x live` (columns in `live_channels` order).
+    pub fn whitening_matrix(&self) -> &DMatrix<f64> {
+        &self.rows
+    }
+
+    /// The PCA of `stats`: dead channels, spectrum, `m`, the kept axes and the whitening rows.
+    pub(crate) fn from_stats(stats: Stats, components: Components) -> Result<Self, FitError> {
+        let channels = stats.mean.len();
+        let (live, dead, cov) = classify_channels(channels, &stats.seen, stats.cov)?;
+        let mut eigenvalues = eigen::sorted_eigenvalues(&cov);
+        let lmax = eigenvalues.first().copied().unwrap_or(0.0);
+        let rank = eigenvalues
+            .iter()
+            .take_while(|&&l| l > RANK_RELATIVE_EIGENVALUE * lmax)
+            .count();
+        let m = choose_m(components, &eigenvalues, rank)?;
+        let total: f64 = eigenvalues.iter().sum();
+        let variance_kept = eigenvalues[..m].iter().sum::<f64>() / total;
+        let (leading, basis) = eigen::leading(&cov, &eigenvalues, m);
+        // The Rayleigh quotients of the kept axes scale them to exactly unit variance.
+        eigenvalues[..m].copy_from_slice(&leading);
+        let mut rows = basis.transpose();
+        for (i, mut row) in rows.row_iter_mut().enumerate() {
+            row /= eigenvalues[i].sqrt();
+        }
+        Ok(Whitener {
+            mean: stats.mean,
+            dead_channels: dead,
+            live_channels: live,
+            eigenvalues,
+            rank,
+            variance_kept,
+            basis,
+            frames_used: stats.frames_used,
+            frames_total: stats.frames_total,
+            rows,
+        })
+    }
+}
+
+/// Fewer than `m + 1` (at least 2) used frames cannot give a rank-`m` covariance.
+pub(crate) fn check_frames(
+    components: Components,
+    used: usize,
+    total: usize,
+) -> Result<(), FitError> {
+    let needed = match components {
+        Components::Fixed(m) => m + 1,
+        Components::VarianceTarget(_) => 2,
+    }
+    .max(2);
+    if used < needed {
+        return Err(FitError::TooFewFrames {
+            used,
+            total,
+            needed,
+        });
+    }
+    Ok(())
+}
+
+/// Live channels, dead channels and the live block of the covariance.
+type LiveSplit = (Vec<usize>, Vec<usize>, DMatrix<f64>);
+
+/// Splits channels into live ones and dead ones (missing everywhere, or variance at most
+/// [`DEAD_CHANNEL_RELATIVE_VARIANCE`] of the largest), given the covariance of the `seen`
+/// channels; returns the live channels, the dead ones and the live block of the covariance.
+/// A constant channel keeps its constant as mean, so the reconstruction `mean + M u` is right for
+/// it; one never seen has mean 0.
+fn classify_channels(
+    channels: usize,
+    seen: &[usize],
+    cov: DMatrix<f64>,
+) -> Result<LiveSplit, FitError> {
+    let max_var = cov.diagonal().iter().copied().fold(0.0f64, f64::max);
+    if max_var <= 0.0 {
+        return Err(FitError::NoVariance { channels });
+    }
+    let keep: Vec<usize> = (0..seen.len())
+        .filter(|&i| cov[(i, i)] > DEAD_CHANNEL_RELATIVE_VARIANCE * max_var)
+        .collect();
+    let mut is_live = vec![false; channels];
+    keep.iter().for_each(|&i| is_live[seen[i]] = true);
+    let (live, dead) = (0..channels).partition(|&c| is_live[c]);
+    let cov = if keep.len() == seen.len() {
+        cov
+    } else {
+        cov.select_rows(&keep).select_columns(&keep)
+    };
+    Ok((live, dead, cov))
+}
+
+/// Picks `m` from the request and the spectrum.
+fn choose_m(components: Components, eigenvalues: &[f64], rank: usize) -> Result<usize, FitError> {
+    match components {
+        Components::Fixed(m) if m > rank => Err(FitError::ComponentsExceedRank { m, rank }),
+        Components::Fixed(m) => Ok(m),
+        Components::VarianceTarget(target) => {
+            let total: f64 = eigenvalues.iter().sum();
+            let mut acc = 0.0;
+            for (i, &l) in eigenvalues.iter().enumerate().take(rank) {
+                acc += l;
+                if acc >= target * total {
+                    return Ok(i + 1);
+                }
+            }
+            Ok(rank.max(1))
+        }
+    }
+}
