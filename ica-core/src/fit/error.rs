@@ -88,4 +88,12 @@ pub enum FitError {
     /// A restart count of zero.
     #[error("restarts must be at least 1, got 0")]
     ZeroRestarts,
+    /// A chunk or partial accumulator of another width than the fit's.
+    #[error("expected frames of {expected} values, got {got}")]
+    ChannelMismatch {
+        /// Values per frame the fit was set up for.
+        expected: usize,
+        /// Values per frame given.
+        got: usize,
+    },
 }

@@ -4,13 +4,23 @@
 //! only), decomposed with nalgebra's `SymmetricEigen`, and the principal axes are sorted by
 //! variance. The first `m` axes, each scaled to unit variance, whiten the data; FastICA then
 //! only has to find a rotation of them.
+//!
+//! Two ways in, one PCA ([`Whitener`]):
+//! - in memory, [`whiten`] scans a [`FitData`] holding every frame;
+//! - streaming, [`Moments`] accumulates mean and covariance chunk by chunk (mergeable, so
+//!   chunks can be folded on several threads), [`Whitener::from_moments`] fits the same PCA,
+//!   and [`Whitener::whiten_into`] whitens one chunk at a time into a caller buffer.
 
 mod eigen;
+mod moments;
 mod pca;
 mod stats;
 mod syrk;
+mod transform;
 
+pub use moments::Moments;
 pub use pca::Whitener;
+pub use transform::FromF64;
 
 use pca::Stats;
 
@@ -147,6 +157,7 @@ pub(crate) fn whiten_parts<T: Copy + Into<f64>>(
     let w = Whitener::from_stats(
         Stats {
             mean,
+            missing_everywhere: sel.always_missing,
             seen,
             cov,
             frames_used: sel.used_frames.len(),

@@ -1,15 +1,17 @@
-//! The fitted PCA whitening transform, built from a covariance, apart from the scans that
-//! produce the covariance (so another source of statistics can share it).
+//! The fitted PCA whitening transform, built from a covariance: shared by the in-memory
+//! [`super::whiten`] and the streaming path ([`Whitener::from_moments`]), so both pick the same
+//! dead channels, components and axes from the same statistics.
 
 use nalgebra::DMatrix;
 
-use super::{eigen, Components, DEAD_CHANNEL_RELATIVE_VARIANCE, RANK_RELATIVE_EIGENVALUE};
+use super::{eigen, Components, Moments, DEAD_CHANNEL_RELATIVE_VARIANCE, RANK_RELATIVE_EIGENVALUE};
 use crate::fit::FitError;
 
 /// PCA whitening fitted to the used frames, without the data: `z = Λ^{-1/2} Eᵀ (x - mean)` on
 /// the live channels.
 ///
-/// Built inside [`super::whiten`] from the covariance of the used frames.
+/// Built by [`Whitener::from_moments`] (streaming) or inside [`super::whiten`] (in memory);
+/// [`Whitener::whiten_into`] applies it to a chunk of frames.
 #[derive(Debug, Clone)]
 pub struct Whitener {
     /// Per-channel mean over the used frames (channels long; 0 for channels missing everywhere).
@@ -33,12 +35,16 @@ pub struct Whitener {
     pub frames_total: usize,
     /// `Λ^{-1/2} Eᵀ`, `m x live`.
     pub(crate) rows: DMatrix<f64>,
+    /// Channels missing in every frame (a frame is used when exactly these are missing).
+    pub(crate) missing_everywhere: Vec<bool>,
 }
 
 /// What the PCA is computed from: the statistics of the used frames.
 pub(crate) struct Stats {
     /// Per-channel mean (channels long).
     pub mean: Vec<f64>,
+    /// Channels missing in every frame.
+    pub missing_everywhere: Vec<bool>,
     /// Channels not missing everywhere, ascending.
     pub seen: Vec<usize>,
     /// Unbiased covariance of the `seen` channels.
@@ -50,6 +56,36 @@ pub(crate) struct Stats {
 }
 
 impl Whitener {
+    /// Fits the whitening to streamed statistics, exactly as [`super::whiten`] would to the
+    /// same frames held in memory.
+    ///
+    /// # Errors
+    /// A bad component request, fewer than `m + 1` (at least 2) used frames, every channel dead,
+    /// or `m` above the rank: see [`FitError`].
+    pub fn from_moments(moments: &Moments, components: Components) -> Result<Self, FitError> {
+        components.check()?;
+        check_frames(components, moments.frames_used(), moments.frames_total())?;
+        let missing = moments.missing_everywhere().to_vec();
+        let seen: Vec<usize> = (0..moments.channels()).filter(|&c| !missing[c]).collect();
+        if seen.is_empty() {
+            return Err(FitError::NoVariance {
+                channels: moments.channels(),
+            });
+        }
+        let cov = moments.covariance_of(&seen);
+        Self::from_stats(
+            Stats {
+                mean: moments.mean().to_vec(),
+                missing_everywhere: missing,
+                seen,
+                cov,
+                frames_used: moments.frames_used(),
+                frames_total: moments.frames_total(),
+            },
+            components,
+        )
+    }
+
     /// Components kept (`m`).
     pub fn components(&self) -> usize {
         self.basis.ncols()
@@ -63,6 +99,12 @@ impl Whitener {
     /// The whitening matrix `Λ^{-1/2} Eᵀ`, `m x live` (columns in `live_channels` order).
     pub fn whitening_matrix(&self) -> &DMatrix<f64> {
         &self.rows
+    }
+
+    /// Whether a frame with these missing flags (`None`: nothing missing) is used: exactly the
+    /// channels missing in every frame may be missing.
+    pub fn frame_is_used(&self, missing: Option<&[bool]>) -> bool {
+        frame_is_used(&self.missing_everywhere, missing)
     }
 
     /// The PCA of `stats`: dead channels, spectrum, `m`, the kept axes and the whitening rows.
@@ -96,7 +138,16 @@ impl Whitener {
             frames_used: stats.frames_used,
             frames_total: stats.frames_total,
             rows,
+            missing_everywhere: stats.missing_everywhere,
         })
+    }
+}
+
+/// A frame is used when its missing channels are exactly those missing everywhere.
+pub(crate) fn frame_is_used(missing_everywhere: &[bool], missing: Option<&[bool]>) -> bool {
+    match missing {
+        None => !missing_everywhere.contains(&true),
+        Some(flags) => flags == missing_everywhere,
     }
 }
 

@@ -45,3 +45,14 @@ pub(crate) fn mirror_upper(m: &mut DMatrix<f64>) {
         }
     }
 }
+
+/// `m[i, j] += scale d_i d_j` for `i <= j`.
+pub(crate) fn rank_one_upper(m: &mut DMatrix<f64>, d: &[f64], scale: f64) {
+    for (j, &dj) in d.iter().enumerate() {
+        let s = scale * dj;
+        let col = &mut m.as_mut_slice()[j * d.len()..j * d.len() + j + 1];
+        for (v, &di) in col.iter_mut().zip(d) {
+            *v += s * di;
+        }
+    }
+}
