@@ -49,9 +49,9 @@ pub(crate) fn sources_into(z: &DMatrix<f64>, w: &DMatrix<f64>, out: &mut DMatrix
 /// overshoots), so the step is halved then, and again at twice and four times that count, down
 /// to [`MIN_STEP`]. A damped step keeps the same fixed points. (Hyvärinen's `fastica.m` also
 /// halves the step on 2-cycles for one iteration; here that created cycles of its own.)
-#[derive(Debug)]
-struct StepControl {
-    mu: f64,
+#[derive(Debug, Clone)]
+pub(crate) struct StepControl {
+    pub(crate) mu: f64,
     next_halving: usize,
 }
 
@@ -61,7 +61,7 @@ const FIRST_HALVING: usize = 40;
 const MIN_STEP: f64 = 0.1;
 
 impl StepControl {
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self {
             mu: 1.0,
             next_halving: FIRST_HALVING,
@@ -69,7 +69,7 @@ impl StepControl {
     }
 
     /// Adapts the step after iteration `it` (1-based).
-    fn after(&mut self, it: usize) {
+    pub(crate) fn after(&mut self, it: usize) {
         if it >= self.next_halving && self.mu > MIN_STEP {
             self.next_halving *= 2;
             self.mu = (self.mu * 0.5).max(MIN_STEP);
@@ -134,8 +134,8 @@ pub(crate) fn run(
 
 /// One symmetric step from the pass's sums: `next = B^T / T - diag(E g') W` (rows `i` of `W`,
 /// `B = Σ z g(y)^T`, `gp[i] = E g'(y_i)`), damped by `mu` when below 1, then decorrelated.
-/// Returns the change `max |1 - |diag(next W^T)||`, the step from a pass's sums, apart from how
-/// the sums are formed.
+/// Returns the change `max |1 - |diag(next W^T)||`. Shared by the in-memory run and the
+/// chunked [`super::Refiner`], so both take the same step from the same sums.
 pub(crate) fn next_rotation(
     w: &DMatrix<f64>,
     b: &DMatrix<f64>,

@@ -96,4 +96,8 @@ pub enum FitError {
         /// Values per frame given.
         got: usize,
     },
+    /// A FastICA accumulator made for another rotation or iteration than the one it was
+    /// handed to (a stale result from an earlier pass, or partials of different passes merged).
+    #[error("accumulator was made for another rotation or iteration")]
+    AccumulatorMismatch,
 }
