@@ -218,6 +218,11 @@ impl SourceMoments {
         Ok(())
     }
 
+    /// The rotation the sums are for.
+    pub(crate) fn w(&self) -> &DMatrix<f64> {
+        &self.w
+    }
+
     /// Total negentropy approximation `Σ_i (E G(u_i) - E G(ν))²` (0 with no frames).
     pub fn negentropy(&self) -> f64 {
         if self.frames == 0 {

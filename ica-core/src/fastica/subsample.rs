@@ -5,6 +5,8 @@
 //! counts for free before the whitening pass, so the subsample is exactly the in-memory one:
 //! a reservoir would draw a different, random set (and different restart results) for no gain.
 
+use nalgebra::DMatrix;
+
 use super::EXPLORE_FRAMES;
 use crate::fit::FitError;
 
@@ -105,5 +107,11 @@ impl Subsample {
             self.seen += 1;
         }
         Ok(())
+    }
+
+    /// The kept frames as the `m x n` matrix the in-memory FastICA takes.
+    pub(crate) fn into_matrix(self) -> DMatrix<f64> {
+        let n = self.frames_kept();
+        DMatrix::from_vec(self.m, n, self.z)
     }
 }

@@ -13,6 +13,24 @@
 //! restart) the restarts run on an evenly strided subsample and only the winner is refined on all
 //! frames; the winner's [`crate::RestartReport::refinement`] says how that went.
 //!
+//! # Hours of takes: the streaming fit
+//! [`FastIcaParams::fit`] needs every frame in memory. [`FastIcaParams::fit_stream`] gives the
+//! same output from frames read in passes (a [`ChunkSource`]), with the whitened frames kept in
+//! a [`WhitenedStore`] between passes: memory is bounded by a chunk, the covariance and the
+//! restarts' subsample, and the cost is linear in frames. [`StreamFit`] is the same fit as a
+//! sans-IO state machine, for drivers that fold chunks on several threads:
+//!
+//! | Pass | Reads | Kernel (map, then `merge` in chunk order) | Memory per partial |
+//! |---|---|---|---|
+//! | statistics | raw frames | [`crate::whiten::Moments`] | `channels²` f64 + 128 frames |
+//! | whitening | raw frames | [`crate::whiten::Whitener::whiten_into`], then [`crate::fastica::Subsample::push`] in frame order | one chunk out |
+//! | update (per iteration) | whitened | [`crate::fastica::UpdateAccumulator`] | `m²` f64 + 1024 frames |
+//! | sources (once) | whitened | [`crate::fastica::SourceMoments`] | `4 m` f64 + 1024 frames |
+//!
+//! The restarts run in memory on the subsample between the whitening pass and the first
+//! update; a short take is fitted in memory from the subsample (all of its frames). The
+//! streaming output has no `sources` and no `used_frames` list (see [`FitOutput`]).
+//!
 //! The model is `x ≈ mean + M u` with `M = P A` (paper eq. 2) in the original channel space and
 //! `u = W (x - mean)` with `W` the whitening followed by the ICA rotation.
 //!
@@ -30,11 +48,15 @@ mod data;
 mod error;
 pub mod mixture;
 mod params;
+mod source;
+mod stream;
 
 pub use amari::amari_index;
 pub use data::FitData;
 pub use error::FitError;
 pub use params::{FastIcaParams, DEFAULT_MAX_ITER, DEFAULT_RESTARTS, DEFAULT_SEED, DEFAULT_TOL};
+pub use source::{ChunkSource, MemorySource, MemoryStore, StreamError, WhitenedStore};
+pub use stream::{Pass, StreamFit};
 
 pub use crate::fastica::{Algorithm, Contrast};
 pub use crate::whiten::Components;
@@ -63,9 +85,14 @@ pub struct FitOutput {
     /// Marker-space variance each component explains, `|M_i|^2`, in component order (decreasing).
     pub component_variance: Vec<f64>,
     /// The components of the used frames, `frames_used x m` (row `r` is frame `used_frames[r]`),
-    /// unit variance; `None` if [`FastIcaParams::keep_sources`] was off.
+    /// unit variance; `None` if [`FastIcaParams::keep_sources`] was off, and always `None` from
+    /// the streaming fit ([`FastIcaParams::fit_stream`], [`StreamFit`]), which keeps no
+    /// per-frame state.
     pub sources: Option<DMatrix<f64>>,
-    /// Indices of the frames used for training, ascending.
+    /// Indices of the frames used for training, ascending. Empty from the streaming fit: its
+    /// count is `report.frames_used`, and a frame was used exactly when
+    /// [`crate::whiten::Whitener::frame_is_used`] says so (no missing sample except on channels
+    /// missing in every frame).
     pub used_frames: Vec<usize>,
     /// What training did.
     pub report: TrainReport,
