@@ -120,7 +120,8 @@ impl Whitener {
         let m = choose_m(components, &eigenvalues, rank)?;
         let total: f64 = eigenvalues.iter().sum();
         let variance_kept = eigenvalues[..m].iter().sum::<f64>() / total;
-        let (leading, basis) = eigen::leading(&cov, &eigenvalues, m);
+        let (leading, mut basis) = eigen::leading(&cov, &eigenvalues, m);
+        sign_axes(&mut basis);
         // The Rayleigh quotients of the kept axes scale them to exactly unit variance.
         eigenvalues[..m].copy_from_slice(&leading);
         let mut rows = basis.transpose();
@@ -140,6 +141,22 @@ impl Whitener {
             rows,
             missing_everywhere: stats.missing_everywhere,
         })
+    }
+}
+
+/// Signs each axis so that its largest-magnitude loading is positive.
+///
+/// Eigen-solvers return an axis with either sign, and which one is decided by rounding noise:
+/// one ulp in one sample of a take flipped axes of the whole fit. The sign does not change the
+/// whitened space, but the seeded restarts start from fixed matrices in it, so it decided where
+/// they started and so the result at the level of the convergence tolerance. With the axes
+/// signed by the data, the in-memory and the streaming fit (whose covariances differ by
+/// rounding) start from the same points and end at the same rotation.
+fn sign_axes(basis: &mut DMatrix<f64>) {
+    for mut axis in basis.column_iter_mut() {
+        if axis[axis.iamax()] < 0.0 {
+            axis.neg_mut();
+        }
     }
 }
 
@@ -218,6 +235,30 @@ fn choose_m(components: Components, eigenvalues: &[f64], rank: usize) -> Result<
                 }
             }
             Ok(rank.max(1))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::fit::{mixture, FitData};
+    use crate::whiten::{whiten, Components};
+
+    /// Issue 18: the PCA axes' signs follow the data, not the eigen-solver's rounding.
+    #[test]
+    fn issue_18_one_ulp_does_not_flip_an_axis() {
+        let mix = mixture::face_like(4_000, 60, 6, 0.2, 3);
+        let data = FitData::new(&mix.samples, 60).expect("whole frames");
+        let a = whiten(&data, Components::Fixed(6)).expect("whitens");
+        for at in [12_345, 99_999, 200_001] {
+            let mut x = mix.samples.clone();
+            x[at] = f32::from_bits(x[at].to_bits() + 1);
+            let nudged = FitData::new(&x, 60).expect("whole frames");
+            let b = whiten(&nudged, Components::Fixed(6)).expect("whitens");
+            for k in 0..6 {
+                let cos = a.basis.column(k).dot(&b.basis.column(k));
+                assert!(cos > 1.0 - 1e-9, "sample {at}: axis {k} turned, cos {cos}");
+            }
         }
     }
 }
