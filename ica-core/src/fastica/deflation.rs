@@ -54,7 +54,7 @@ pub(crate) fn run(
 }
 
 /// Removes the projections on the first `p` rows of `w` and normalises to unit length.
-fn orthonormalise(v: &mut DVector<f64>, w: &DMatrix<f64>, p: usize) {
+pub(crate) fn orthonormalise(v: &mut DVector<f64>, w: &DMatrix<f64>, p: usize) {
     for j in 0..p {
         let row = w.row(j);
         let c = row.dot(&v.transpose());

@@ -5,14 +5,25 @@
 //! Each restart draws its start from a ChaCha8 stream seeded with
 //! `seed + k * 0x9E37_79B9_7F4A_7C15` (restart `k`, wrapping), so results depend on the seed
 //! only: there are no threads and no clock.
+//!
+//! For data too long to hold, the same iteration runs one pass over the data per step:
+//! [`UpdateAccumulator`] (map/merge sums of a step), [`Refiner`] (the pass-by-pass state
+//! machine), [`SourceMoments`] (negentropy and skewness of the result) and [`Subsample`] (the
+//! restarts' subsample, collected while streaming).
 
+mod chunked;
 mod contrast;
 mod deflation;
 mod gemm;
+mod refine;
+mod subsample;
 mod symmetric;
 
+pub use chunked::{SourceMoments, Update, UpdateAccumulator};
 pub use contrast::Contrast;
 pub(crate) use gemm::{mul_add, strided};
+pub use refine::{refine_chunked, ChunkSink, RefineOutcome, RefineSettings, Refiner};
+pub use subsample::{Subsample, SubsamplePlan};
 
 use nalgebra::DMatrix;
 use rand::SeedableRng;
@@ -162,7 +173,7 @@ fn negentropy(
 }
 
 /// The seeded restarts on `z`, each from its own random start; keeps the best (see [`run`]).
-fn explore(z: &DMatrix<f64>, s: Settings) -> IcaRun {
+pub(crate) fn explore(z: &DMatrix<f64>, s: Settings) -> IcaRun {
     let (m, frames) = z.shape();
     let mut ws = symmetric::Workspace::new(m, frames);
     let mut best: Option<(usize, f64, DMatrix<f64>, DMatrix<f64>)> = None;
@@ -241,7 +252,7 @@ pub(crate) fn stability(kept: &DMatrix<f64>, restarts: &[DMatrix<f64>], best: us
 
 /// A standard-normal `m x m` start drawn from the restart's seed (rows are orthonormalised by the
 /// update itself).
-fn random_start(m: usize, seed: u64) -> DMatrix<f64> {
+pub(crate) fn random_start(m: usize, seed: u64) -> DMatrix<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     DMatrix::from_fn(m, m, |_, _| StandardNormal.sample(&mut rng))
 }

@@ -49,9 +49,9 @@ pub(crate) fn sources_into(z: &DMatrix<f64>, w: &DMatrix<f64>, out: &mut DMatrix
 /// overshoots), so the step is halved then, and again at twice and four times that count, down
 /// to [`MIN_STEP`]. A damped step keeps the same fixed points. (Hyvärinen's `fastica.m` also
 /// halves the step on 2-cycles for one iteration; here that created cycles of its own.)
-#[derive(Debug)]
-struct StepControl {
-    mu: f64,
+#[derive(Debug, Clone)]
+pub(crate) struct StepControl {
+    pub(crate) mu: f64,
     next_halving: usize,
 }
 
@@ -61,7 +61,7 @@ const FIRST_HALVING: usize = 40;
 const MIN_STEP: f64 = 0.1;
 
 impl StepControl {
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self {
             mu: 1.0,
             next_halving: FIRST_HALVING,
@@ -69,7 +69,7 @@ impl StepControl {
     }
 
     /// Adapts the step after iteration `it` (1-based).
-    fn after(&mut self, it: usize) {
+    pub(crate) fn after(&mut self, it: usize) {
         if it >= self.next_halving && self.mu > MIN_STEP {
             self.next_halving *= 2;
             self.mu = (self.mu * 0.5).max(MIN_STEP);
@@ -112,16 +112,7 @@ pub(crate) fn run(
             *gp = contrast.apply(col) * inv_t;
         }
         mul_add(&mut ws.b, 1.0, z, &ws.gy, 0.0);
-        for i in 0..m {
-            for j in 0..m {
-                w_new[(i, j)] = ws.b[(j, i)] * inv_t - ws.gp[i] * w[(i, j)];
-            }
-        }
-        if step.mu < 1.0 {
-            damp(&mut w_new, &w, step.mu);
-        }
-        decorrelate(&mut w_new);
-        delta = row_change(&w_new, &w);
+        delta = next_rotation(&w, &ws.b, &ws.gp, inv_t, step.mu, &mut w_new);
         std::mem::swap(&mut w, &mut w_new);
         if delta < tol {
             return Outcome {
@@ -139,6 +130,30 @@ pub(crate) fn run(
         converged: false,
         last_delta: delta,
     }
+}
+
+/// One symmetric step from the pass's sums: `next = B^T / T - diag(E g') W` (rows `i` of `W`,
+/// `B = Σ z g(y)^T`, `gp[i] = E g'(y_i)`), damped by `mu` when below 1, then decorrelated.
+/// Returns the change `max |1 - |diag(next W^T)||`. Shared by the in-memory run and the
+/// chunked [`super::Refiner`], so both take the same step from the same sums.
+pub(crate) fn next_rotation(
+    w: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    gp: &[f64],
+    inv_t: f64,
+    mu: f64,
+    next: &mut DMatrix<f64>,
+) -> f64 {
+    for i in 0..w.nrows() {
+        for j in 0..w.ncols() {
+            next[(i, j)] = b[(j, i)] * inv_t - gp[i] * w[(i, j)];
+        }
+    }
+    if mu < 1.0 {
+        damp(next, w, mu);
+    }
+    decorrelate(next);
+    row_change(next, w)
 }
 
 /// Replaces each row of `next` by the normalised blend `(1 - mu) w_i + mu n_i`, where `n_i` is

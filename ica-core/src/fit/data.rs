@@ -60,6 +60,19 @@ impl<'a, T: Copy + Into<f64>> FitData<'a, T> {
         Ok(self)
     }
 
+    /// Frames `start..end` as data of their own (the mask sliced alike).
+    ///
+    /// # Panics
+    /// If `start > end` or `end > self.frames()`.
+    pub fn slice_frames(&self, start: usize, end: usize) -> Self {
+        let range = start * self.channels..end * self.channels;
+        Self {
+            samples: &self.samples[range.clone()],
+            channels: self.channels,
+            missing: self.missing.map(|m| &m[range]),
+        }
+    }
+
     /// Frames in the data.
     pub fn frames(&self) -> usize {
         self.samples.len() / self.channels
@@ -73,6 +86,11 @@ impl<'a, T: Copy + Into<f64>> FitData<'a, T> {
     /// One frame's samples.
     pub(crate) fn frame(&self, frame: usize) -> &'a [T] {
         &self.samples[frame * self.channels..(frame + 1) * self.channels]
+    }
+
+    /// Every sample, row-major.
+    pub(crate) fn samples(&self) -> &'a [T] {
+        self.samples
     }
 
     /// Whether a missing-sample mask was given.

@@ -2,6 +2,8 @@
 
 use thiserror::Error;
 
+use super::Pass;
+
 /// Everything that makes [`crate::fit::FastIcaParams::fit`] refuse its input or parameters.
 ///
 /// Numerical non-convergence is *not* an error: it is reported per restart in
@@ -88,4 +90,35 @@ pub enum FitError {
     /// A restart count of zero.
     #[error("restarts must be at least 1, got 0")]
     ZeroRestarts,
+    /// A chunk or partial accumulator of another width than the fit's.
+    #[error("expected frames of {expected} values, got {got}")]
+    ChannelMismatch {
+        /// Values per frame the fit was set up for.
+        expected: usize,
+        /// Values per frame given.
+        got: usize,
+    },
+    /// A streaming pass saw another number of used frames than the statistics pass: the chunk
+    /// source did not give the same frames on every pass.
+    #[error("the {pass} pass saw {got} used frames, the statistics pass counted {expected}")]
+    FrameCountMismatch {
+        /// The pass that disagreed.
+        pass: Pass,
+        /// Used frames counted by the statistics pass.
+        expected: usize,
+        /// Used frames this pass saw.
+        got: usize,
+    },
+    /// A streaming pass's result was handed in when another pass was due.
+    #[error("the {expected} pass is due, got the result of a {got} pass")]
+    UnexpectedPass {
+        /// The pass that is due.
+        expected: Pass,
+        /// The pass whose result was given.
+        got: Pass,
+    },
+    /// A FastICA accumulator made for another rotation or iteration than the one it was
+    /// handed to (a stale result from an earlier pass, or partials of different passes merged).
+    #[error("accumulator was made for another rotation or iteration")]
+    AccumulatorMismatch,
 }

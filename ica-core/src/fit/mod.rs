@@ -13,6 +13,24 @@
 //! restart) the restarts run on an evenly strided subsample and only the winner is refined on all
 //! frames; the winner's [`crate::RestartReport::refinement`] says how that went.
 //!
+//! # Hours of takes: the streaming fit
+//! [`FastIcaParams::fit`] needs every frame in memory. [`FastIcaParams::fit_stream`] gives the
+//! same output from frames read in passes (a [`ChunkSource`]), with the whitened frames kept in
+//! a [`WhitenedStore`] between passes: memory is bounded by a chunk, the covariance and the
+//! restarts' subsample, and the cost is linear in frames. [`StreamFit`] is the same fit as a
+//! sans-IO state machine, for drivers that fold chunks on several threads:
+//!
+//! | Pass | Reads | Kernel (map, then `merge` in chunk order) | Memory per partial |
+//! |---|---|---|---|
+//! | statistics | raw frames | [`crate::whiten::Moments`] | `channels²` f64 + 128 frames |
+//! | whitening | raw frames | [`crate::whiten::Whitener::whiten_into`], then [`crate::fastica::Subsample::push`] in frame order | one chunk out |
+//! | update (per iteration) | whitened | [`crate::fastica::UpdateAccumulator`] | `m²` f64 + 1024 frames |
+//! | sources (once) | whitened | [`crate::fastica::SourceMoments`] | `4 m` f64 + 1024 frames |
+//!
+//! The restarts run in memory on the subsample between the whitening pass and the first
+//! update; a short take is fitted in memory from the subsample (all of its frames). The
+//! streaming output has no `sources` and no `used_frames` list (see [`FitOutput`]).
+//!
 //! The model is `x ≈ mean + M u` with `M = P A` (paper eq. 2) in the original channel space and
 //! `u = W (x - mean)` with `W` the whitening followed by the ICA rotation.
 //!
@@ -25,15 +43,20 @@
 //! column is made positive instead.
 
 mod amari;
+mod assemble;
 mod data;
 mod error;
 pub mod mixture;
 mod params;
+mod source;
+mod stream;
 
 pub use amari::amari_index;
 pub use data::FitData;
 pub use error::FitError;
 pub use params::{FastIcaParams, DEFAULT_MAX_ITER, DEFAULT_RESTARTS, DEFAULT_SEED, DEFAULT_TOL};
+pub use source::{ChunkSource, MemorySource, MemoryStore, StreamError, WhitenedStore};
+pub use stream::{Pass, StreamFit};
 
 pub use crate::fastica::{Algorithm, Contrast};
 pub use crate::whiten::Components;
@@ -41,8 +64,9 @@ pub use crate::whiten::Components;
 use nalgebra::DMatrix;
 
 use crate::fastica::{self, Settings};
-use crate::whiten::{self, Whitening};
+use crate::whiten::{self, Whitener};
 use crate::TrainReport;
+use assemble::Solved;
 
 /// Skewness below this many standard errors counts as zero for the sign convention.
 pub const SKEW_SIGNIFICANT: f64 = 3.0;
@@ -61,9 +85,14 @@ pub struct FitOutput {
     /// Marker-space variance each component explains, `|M_i|^2`, in component order (decreasing).
     pub component_variance: Vec<f64>,
     /// The components of the used frames, `frames_used x m` (row `r` is frame `used_frames[r]`),
-    /// unit variance; `None` if [`FastIcaParams::keep_sources`] was off.
+    /// unit variance; `None` if [`FastIcaParams::keep_sources`] was off, and always `None` from
+    /// the streaming fit ([`FastIcaParams::fit_stream`], [`StreamFit`]), which keeps no
+    /// per-frame state.
     pub sources: Option<DMatrix<f64>>,
-    /// Indices of the frames used for training, ascending.
+    /// Indices of the frames used for training, ascending. Empty from the streaming fit: its
+    /// count is `report.frames_used`, and a frame was used exactly when
+    /// [`crate::whiten::Whitener::frame_is_used`] says so (no missing sample except on channels
+    /// missing in every frame).
     pub used_frames: Vec<usize>,
     /// What training did.
     pub report: TrainReport,
@@ -79,142 +108,48 @@ impl FastIcaParams {
     /// or `m` above the data's rank: see [`FitError`].
     pub fn fit<T: Copy + Into<f64>>(&self, data: &FitData<'_, T>) -> Result<FitOutput, FitError> {
         self.check()?;
-        let wh = whiten::whiten(data, self.components)?;
-        let run = fastica::run(
-            &wh.whitened,
-            Settings {
-                contrast: self.contrast,
-                algorithm: self.algorithm,
-                tol: self.tol,
-                max_iter: self.max_iter,
-                seed: self.seed,
-                restarts: self.restarts,
-            },
-        );
-        let stability = fastica::stability(&run.w, &run.restart_w, run.best);
-        let (mixing, unmixing, sources) = assemble(&wh, &run.w, run.sources, data.channels());
-        let (mixing, unmixing, sources, component_variance, order) =
-            canonicalise(mixing, unmixing, sources);
-        let stability = if stability.is_empty() {
-            stability
-        } else {
-            order.iter().map(|&i| stability[i]).collect()
-        };
-        let report = TrainReport {
-            frames_total: wh.frames_total,
-            frames_used: wh.used_frames.len(),
-            channels: data.channels(),
-            dead_channels: wh.dead_channels.clone(),
-            components: wh.components(),
-            variance_kept: wh.variance_kept,
-            eigenvalues: wh.eigenvalues.clone(),
-            contrast: self.contrast.name().to_owned(),
-            algorithm: self.algorithm.name().to_owned(),
+        let (wh, whitened, used_frames) = whiten::whiten_parts(data, self.components)?;
+        let run = fastica::run(&whitened, self.settings());
+        let (mut out, sources) = self.finish_in_memory(&wh, run);
+        out.sources = self.keep_sources.then_some(sources);
+        out.used_frames = used_frames;
+        Ok(out)
+    }
+
+    /// The iteration settings of these parameters.
+    pub(crate) fn settings(&self) -> Settings {
+        Settings {
+            contrast: self.contrast,
+            algorithm: self.algorithm,
             tol: self.tol,
             max_iter: self.max_iter,
+            seed: self.seed,
+            restarts: self.restarts,
+        }
+    }
+
+    /// The output of a FastICA run over every used frame held in memory, and its sources in
+    /// canonical order and sign (`frames x m`).
+    pub(crate) fn finish_in_memory(
+        &self,
+        wh: &Whitener,
+        run: fastica::IcaRun,
+    ) -> (FitOutput, DMatrix<f64>) {
+        let frames = run.sources.nrows();
+        let skew: Vec<f64> = run
+            .sources
+            .as_slice()
+            .chunks_exact(frames.max(1))
+            .map(assemble::skewness)
+            .collect();
+        let solved = Solved {
+            w: run.w,
             restarts: run.restarts,
-            best_restart: run.best,
-            stability,
+            best: run.best,
+            restart_w: run.restart_w,
         };
-        Ok(FitOutput {
-            mean: wh.mean,
-            mixing,
-            unmixing,
-            component_variance,
-            sources: self.keep_sources.then_some(sources),
-            used_frames: wh.used_frames,
-            report,
-        })
-    }
-}
-
-/// Maps the rotation back to channel space: `M = E sqrt(Λ) Wᵀ`, `W_full = W Λ^{-1/2} Eᵀ`, with
-/// zero rows/columns for dead channels.
-fn assemble(
-    wh: &Whitening,
-    w: &DMatrix<f64>,
-    sources: DMatrix<f64>,
-    channels: usize,
-) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
-    let m = wh.components();
-    let mut scaled = wh.basis.clone();
-    let mut inv_scaled = wh.basis.clone();
-    for k in 0..m {
-        let s = wh.eigenvalues[k].sqrt();
-        scaled.column_mut(k).scale_mut(s);
-        inv_scaled.column_mut(k).unscale_mut(s);
-    }
-    let mixing_live = scaled * w.transpose();
-    let unmixing_live = w * inv_scaled.transpose();
-    let mut mixing = DMatrix::zeros(channels, m);
-    let mut unmixing = DMatrix::zeros(m, channels);
-    for (r, &c) in wh.live_channels.iter().enumerate() {
-        mixing.row_mut(c).copy_from(&mixing_live.row(r));
-        unmixing.column_mut(c).copy_from(&unmixing_live.column(r));
-    }
-    (mixing, unmixing, sources)
-}
-
-/// Mixing, unmixing and sources in canonical order and sign, each component's variance, and
-/// the original index of each canonical component.
-type Canonical = (
-    DMatrix<f64>,
-    DMatrix<f64>,
-    DMatrix<f64>,
-    Vec<f64>,
-    Vec<usize>,
-);
-
-/// Applies the sign and order convention (see the module docs).
-fn canonicalise(mixing: DMatrix<f64>, unmixing: DMatrix<f64>, sources: DMatrix<f64>) -> Canonical {
-    let m = mixing.ncols();
-    let variance: Vec<f64> = mixing.column_iter().map(|c| c.norm_squared()).collect();
-    let mut order: Vec<usize> = (0..m).collect();
-    order.sort_by(|&a, &b| variance[b].total_cmp(&variance[a]));
-    let frames = sources.nrows();
-    let threshold = SKEW_SIGNIFICANT * (6.0 / frames.max(1) as f64).sqrt();
-    let signs: Vec<f64> = (0..m)
-        .map(|i| {
-            let skew = skewness(&sources.as_slice()[i * frames..(i + 1) * frames]);
-            if skew.abs() >= threshold {
-                skew.signum()
-            } else {
-                let col = mixing.column(i);
-                let k = col.iamax();
-                if col[k] < 0.0 {
-                    -1.0
-                } else {
-                    1.0
-                }
-            }
-        })
-        .collect();
-    let mix = DMatrix::from_fn(mixing.nrows(), m, |r, c| {
-        mixing[(r, order[c])] * signs[order[c]]
-    });
-    let unmix = DMatrix::from_fn(m, unmixing.ncols(), |r, c| {
-        unmixing[(order[r], c)] * signs[order[r]]
-    });
-    let src = DMatrix::from_fn(frames, m, |r, c| sources[(r, order[c])] * signs[order[c]]);
-    let variance = order.iter().map(|&i| variance[i]).collect();
-    (mix, unmix, src, variance, order)
-}
-
-/// Sample skewness `E (y - ȳ)^3 / σ^3` (0 for a constant or empty series).
-pub(crate) fn skewness(ys: &[f64]) -> f64 {
-    if ys.is_empty() {
-        return 0.0;
-    }
-    let n = ys.len() as f64;
-    let mean = ys.iter().sum::<f64>() / n;
-    let (m2, m3) = ys.iter().fold((0.0, 0.0), |(a, b), &y| {
-        let d = y - mean;
-        (a + d * d, b + d * d * d)
-    });
-    let (m2, m3) = (m2 / n, m3 / n);
-    if m2 <= 0.0 {
-        0.0
-    } else {
-        m3 / m2.powf(1.5)
+        let (out, canon) = assemble::output(self, wh, solved, &skew, frames);
+        let sources = canon.sources(&run.sources);
+        (out, sources)
     }
 }

@@ -4,9 +4,25 @@
 //! only), decomposed with nalgebra's `SymmetricEigen`, and the principal axes are sorted by
 //! variance. The first `m` axes, each scaled to unit variance, whiten the data; FastICA then
 //! only has to find a rotation of them.
+//!
+//! Two ways in, one PCA ([`Whitener`]):
+//! - in memory, [`whiten`] scans a [`FitData`] holding every frame;
+//! - streaming, [`Moments`] accumulates mean and covariance chunk by chunk (mergeable, so
+//!   chunks can be folded on several threads), [`Whitener::from_moments`] fits the same PCA,
+//!   and [`Whitener::whiten_into`] whitens one chunk at a time into a caller buffer.
 
 mod eigen;
+mod moments;
+mod pca;
 mod stats;
+mod syrk;
+mod transform;
+
+pub use moments::Moments;
+pub use pca::{noise_edge, Whitener};
+pub use transform::FromF64;
+
+use pca::Stats;
 
 use nalgebra::DMatrix;
 
@@ -117,21 +133,29 @@ pub fn whiten<T: Copy + Into<f64>>(
     data: &FitData<'_, T>,
     components: Components,
 ) -> Result<Whitening, FitError> {
+    let (w, whitened, used_frames) = whiten_parts(data, components)?;
+    Ok(Whitening {
+        mean: w.mean,
+        dead_channels: w.dead_channels,
+        live_channels: w.live_channels,
+        eigenvalues: w.eigenvalues,
+        rank: w.rank,
+        variance_kept: w.variance_kept,
+        basis: w.basis,
+        whitened,
+        used_frames,
+        frames_total: w.frames_total,
+    })
+}
+
+/// The fitted whitening, the whitened used frames (`m x used`) and the used frames' indices.
+pub(crate) fn whiten_parts<T: Copy + Into<f64>>(
+    data: &FitData<'_, T>,
+    components: Components,
+) -> Result<(Whitener, DMatrix<f64>, Vec<usize>), FitError> {
     components.check()?;
     let sel = stats::select(data)?;
-    let needed = match components {
-        Components::Fixed(m) => m + 1,
-        Components::VarianceTarget(_) | Components::VarianceAboveNoise { .. } => 2,
-    }
-    .max(2);
-    let used = sel.used_frames.len();
-    if used < needed {
-        return Err(FitError::TooFewFrames {
-            used,
-            total: data.frames(),
-            needed,
-        });
-    }
+    pca::check_frames(components, sel.used_frames.len(), data.frames())?;
     let mean = stats::mean(data, &sel);
     // The covariance of every channel seen at least once: its diagonal holds the variances that
     // classify dead channels, which saves a pass over the data.
@@ -144,107 +168,17 @@ pub fn whiten<T: Copy + Into<f64>>(
         });
     }
     let cov = stats::covariance(data, &sel.used_frames, &seen, &mean);
-    let (live, dead, cov) = classify_channels(data.channels(), &seen, cov)?;
-    let mut eigenvalues = eigen::sorted_eigenvalues(&cov);
-    let lmax = eigenvalues.first().copied().unwrap_or(0.0);
-    let rank = eigenvalues
-        .iter()
-        .take_while(|&&l| l > RANK_RELATIVE_EIGENVALUE * lmax)
-        .count();
-    let m = choose_m(components, &eigenvalues, rank, used)?;
-    let total: f64 = eigenvalues.iter().sum();
-    let variance_kept = eigenvalues[..m].iter().sum::<f64>() / total;
-    let (leading, basis) = eigen::leading(&cov, &eigenvalues, m);
-    // The Rayleigh quotients of the kept axes scale them to exactly unit variance.
-    eigenvalues[..m].copy_from_slice(&leading);
-    let mut rows = basis.transpose();
-    for (i, mut row) in rows.row_iter_mut().enumerate() {
-        row /= eigenvalues[i].sqrt();
-    }
-    let whitened = stats::project(data, &sel.used_frames, &live, &mean, &rows);
-    Ok(Whitening {
-        mean,
-        dead_channels: dead,
-        live_channels: live,
-        eigenvalues,
-        rank,
-        variance_kept,
-        basis,
-        whitened,
-        used_frames: sel.used_frames,
-        frames_total: data.frames(),
-    })
-}
-
-/// Live channels, dead channels and the live block of the covariance.
-type LiveSplit = (Vec<usize>, Vec<usize>, DMatrix<f64>);
-
-/// Splits channels into live ones and dead ones (missing everywhere, or variance at most
-/// [`DEAD_CHANNEL_RELATIVE_VARIANCE`] of the largest), given the covariance of the `seen`
-/// channels; returns the live channels, the dead ones and the live block of the covariance.
-/// A constant channel keeps its constant as mean, so the reconstruction `mean + M u` is right for
-/// it; one never seen has mean 0.
-fn classify_channels(
-    channels: usize,
-    seen: &[usize],
-    cov: DMatrix<f64>,
-) -> Result<LiveSplit, FitError> {
-    let max_var = cov.diagonal().iter().copied().fold(0.0f64, f64::max);
-    if max_var <= 0.0 {
-        return Err(FitError::NoVariance { channels });
-    }
-    let keep: Vec<usize> = (0..seen.len())
-        .filter(|&i| cov[(i, i)] > DEAD_CHANNEL_RELATIVE_VARIANCE * max_var)
-        .collect();
-    let mut is_live = vec![false; channels];
-    keep.iter().for_each(|&i| is_live[seen[i]] = true);
-    let (live, dead) = (0..channels).partition(|&c| is_live[c]);
-    let cov = if keep.len() == seen.len() {
-        cov
-    } else {
-        cov.select_rows(&keep).select_columns(&keep)
-    };
-    Ok((live, dead, cov))
-}
-
-/// The largest eigenvalue of the sample covariance of white noise with variance `noise_var`
-/// per channel (Marchenko-Pastur edge).
-pub fn noise_edge(noise_var: f64, channels: usize, frames: usize) -> f64 {
-    let ratio = channels as f64 / frames.max(1) as f64;
-    noise_var * (1.0 + ratio.sqrt()).powi(2)
-}
-
-/// Picks `m` from the request and the spectrum.
-fn choose_m(
-    components: Components,
-    eigenvalues: &[f64],
-    rank: usize,
-    frames: usize,
-) -> Result<usize, FitError> {
-    match components {
-        Components::VarianceAboveNoise { target, noise_var } => {
-            let by_share = choose_m(
-                Components::VarianceTarget(target),
-                eigenvalues,
-                rank,
-                frames,
-            )?;
-            let edge = noise_edge(noise_var, eigenvalues.len(), frames);
-            let signal = eigenvalues.iter().take(rank).filter(|&&l| l > edge).count();
-            Ok(by_share.min(signal).max(1))
-        }
-        Components::Fixed(m) if m > rank => Err(FitError::ComponentsExceedRank { m, rank }),
-        Components::Fixed(m) => Ok(m),
-        Components::VarianceTarget(target) => {
-            let total: f64 = eigenvalues.iter().sum();
-            let mut acc = 0.0;
-            for (i, &l) in eigenvalues.iter().enumerate().take(rank) {
-                acc += l;
-                if acc >= target * total {
-                    return Ok(i + 1);
-                }
-            }
-            Ok(rank.max(1))
-        }
-    }
+    let w = Whitener::from_stats(
+        Stats {
+            mean,
+            missing_everywhere: sel.always_missing,
+            seen,
+            cov,
+            frames_used: sel.used_frames.len(),
+            frames_total: data.frames(),
+        },
+        components,
+    )?;
+    let whitened = stats::project(data, &sel.used_frames, &w.live_channels, &w.mean, &w.rows);
+    Ok((w, whitened, sel.used_frames))
 }

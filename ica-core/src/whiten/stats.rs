@@ -1,9 +1,10 @@
 //! One-pass-per-statistic scans of the training data: which frames count, the mean, the
 //! covariance (whose diagonal gives the per-channel variances) and the whitened projection. All sums are in f64.
 
-use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
+use nalgebra::{DMatrix, DMatrixView};
 
-use crate::fastica::{mul_add, strided};
+use super::syrk::{accumulate_upper, mirror_upper};
+use crate::fastica::mul_add;
 
 use crate::fit::{FitData, FitError};
 
@@ -151,33 +152,12 @@ pub(crate) fn covariance<T: Copy + Into<f64>>(
     let nl = live.len();
     let mut cov = DMatrix::<f64>::zeros(nl, nl);
     for_each_chunk(data, used, live, mean, |_, raw, chunk| {
-        accumulate_upper(&mut cov, raw, chunk);
+        accumulate_upper(&mut cov, raw, chunk, COV_BLOCK);
     });
-    // Mirror the upper block triangle into the lower one.
-    for j in 0..nl {
-        for i in (j + 1)..nl {
-            cov[(i, j)] = cov[(j, i)];
-        }
-    }
+    mirror_upper(&mut cov);
     let dof = (used.len().max(2) - 1) as f64;
     cov /= dof;
     cov
-}
-
-/// `cov[I, J] += chunk[I, :] chunk[J, :]^T` for channel blocks `I <= J` (a blocked syrk).
-fn accumulate_upper(cov: &mut DMatrix<f64>, data: &[f64], chunk: DMatrixView<'_, f64>) {
-    let (nl, frames) = chunk.shape();
-    for i0 in (0..nl).step_by(COV_BLOCK) {
-        let bi = COV_BLOCK.min(nl - i0);
-        let a = chunk.rows(i0, bi);
-        for j0 in (i0..nl).step_by(COV_BLOCK) {
-            let bj = COV_BLOCK.min(nl - j0);
-            // chunk[J, :]^T as a strided view of the same memory: no copy.
-            let bt = strided(&data[j0..], frames, bj, nl, 1);
-            let mut out: DMatrixViewMut<'_, f64> = cov.view_mut((i0, j0), (bi, bj));
-            mul_add(&mut out, 1.0, &a, &bt, 1.0);
-        }
-    }
 }
 
 /// Projects the used frames onto `rows` (`m x live`): returns `m x used` with one frame per column.
