@@ -450,7 +450,10 @@ mod tests {
 
     fn decide(head: bool) -> Choice {
         let (xyz, missing) = scene(3000, head);
-        let takes = vec![Range { start: 0, end: 3000 }];
+        let takes = vec![Range {
+            start: 0,
+            end: 3000,
+        }];
         let frames = MarkerFrames {
             xyz: &xyz,
             missing: &missing,
