@@ -25,6 +25,10 @@ pub const EMOTION_TARGET: &str = "/emotion/target";
 pub const EMOTION_AMOUNT: &str = "/emotion/amount";
 /// Control: set the ramp time in seconds, `,f`.
 pub const EMOTION_RAMP: &str = "/emotion/ramp";
+/// Control: move towards a blend of named emotions, `,sfsf...` (name, weight pairs).
+pub const EMOTION_MIX: &str = "/emotion/mix";
+/// Control: ask for the emotion names and their level vectors, `,`.
+pub const EMOTION_LIST: &str = "/emotion/list";
 /// Control: raw translate of component i, `,if`.
 pub const EMOTION_ALPHA: &str = "/emotion/alpha";
 /// Control: gain of component i, `,if`.
@@ -70,10 +74,12 @@ pub enum Address {
     Confirm,
 }
 
-const CONTROLS: [&str; 12] = [
+const CONTROLS: [&str; 14] = [
     EMOTION_TARGET,
     EMOTION_AMOUNT,
     EMOTION_RAMP,
+    EMOTION_MIX,
+    EMOTION_LIST,
     EMOTION_ALPHA,
     COMPONENT_GAIN,
     BYPASS,

@@ -45,6 +45,12 @@ pub enum Control {
     Amount(f32),
     /// `/emotion/ramp ,f`: seconds to reach a new amount, finite and >= 0.
     Ramp(f32),
+    /// `/emotion/mix ,sfsf...`: move towards a blend of named emotions, each with a weight
+    /// (finite, >= 0, not all 0; the daemon normalises them to sum 1).
+    Mix(Vec<(String, f32)>),
+    /// `/emotion/list ,`: answered with `/emotion/list/confirm` (see
+    /// [`crate::encode_emotion_list_into`]).
+    EmotionList,
     /// `/emotion/alpha ,if`: raw translate of one component.
     Alpha {
         /// Component index.
@@ -219,6 +225,36 @@ fn port(address: &'static str, p: i32) -> Result<u16, ControlError> {
     }
 }
 
+/// `(name, weight)` pairs of `/emotion/mix`: `None` for a wrong type, an error for a bad weight.
+fn mix(
+    address: &'static str,
+    args: &[OscType],
+) -> Option<Result<Vec<(String, f32)>, ControlError>> {
+    let mut out = Vec::with_capacity(args.len() / 2);
+    for pair in args.chunks_exact(2) {
+        let OscType::String(name) = &pair[0] else {
+            return None;
+        };
+        let weight = float(&pair[1])?;
+        if !(weight.is_finite() && weight >= 0.0) {
+            return Some(Err(ControlError::OutOfRange {
+                address,
+                what: "weight",
+                value: weight.to_string(),
+            }));
+        }
+        out.push((name.clone(), weight));
+    }
+    if out.iter().all(|(_, w)| *w == 0.0) {
+        return Some(Err(ControlError::OutOfRange {
+            address,
+            what: "weights",
+            value: "all 0".into(),
+        }));
+    }
+    Some(Ok(out))
+}
+
 /// Parses the arguments of a control address (also used for `/confirm` echoes).
 pub(crate) fn parse_control(address: &str, args: Vec<OscType>) -> Result<Control, ControlError> {
     let Some((addr, expected)) = CONTROL_SHAPES.iter().find(|(c, _)| *c == address) else {
@@ -255,6 +291,10 @@ pub(crate) fn parse_control(address: &str, args: Vec<OscType>) -> Result<Control
             component: component(addr, *i)?,
             gain: finite(addr, "gain", float(v).ok_or_else(wrong)?)?,
         },
+        (a::EMOTION_MIX, pairs) if !pairs.is_empty() && pairs.len() % 2 == 0 => {
+            Control::Mix(mix(addr, pairs).ok_or_else(wrong)??)
+        }
+        (a::EMOTION_LIST, []) => Control::EmotionList,
         (a::BYPASS, [OscType::Int(i)]) => Control::Bypass(*i != 0),
         (a::BYPASS, [OscType::Bool(b)]) => Control::Bypass(*b),
         (a::SUBSCRIBE, [OscType::Int(p), OscType::String(name)]) => Control::Subscribe {
@@ -282,10 +322,12 @@ pub(crate) fn parse_control(address: &str, args: Vec<OscType>) -> Result<Control
 }
 
 /// Control addresses and the type tags each takes (for error messages).
-const CONTROL_SHAPES: [(&str, &str); 12] = [
+const CONTROL_SHAPES: [(&str, &str); 14] = [
     (a::EMOTION_TARGET, ",s"),
     (a::EMOTION_AMOUNT, ",f"),
     (a::EMOTION_RAMP, ",f"),
+    (a::EMOTION_MIX, ",sf or ,sfsf..."),
+    (a::EMOTION_LIST, ","),
     (a::EMOTION_ALPHA, ",if"),
     (a::COMPONENT_GAIN, ",if"),
     (a::BYPASS, ",i"),
@@ -304,6 +346,8 @@ impl Control {
             Control::Target(_) => a::EMOTION_TARGET,
             Control::Amount(_) => a::EMOTION_AMOUNT,
             Control::Ramp(_) => a::EMOTION_RAMP,
+            Control::Mix(_) => a::EMOTION_MIX,
+            Control::EmotionList => a::EMOTION_LIST,
             Control::Alpha { .. } => a::EMOTION_ALPHA,
             Control::Gain { .. } => a::COMPONENT_GAIN,
             Control::Bypass(_) => a::BYPASS,
@@ -341,7 +385,11 @@ impl Control {
                 ]
             }
             Control::Unsubscribe { port } => vec![T::Int(i32::from(*port))],
-            Control::RecordStop | Control::Status => vec![],
+            Control::Mix(pairs) => pairs
+                .iter()
+                .flat_map(|(n, w)| [T::String(n.clone()), T::Float(*w)])
+                .collect(),
+            Control::RecordStop | Control::Status | Control::EmotionList => vec![],
         }
     }
 }

@@ -23,6 +23,8 @@
 //! | `/emotion/target` | `,s` | control | target emotion |
 //! | `/emotion/amount` | `,f` | control | edit amount (finite) |
 //! | `/emotion/ramp` | `,f` | control | ramp time, seconds ≥ 0 |
+//! | `/emotion/mix` | `,sf` + more `sf` | control | move towards a blend: (emotion name, weight ≥ 0) pairs, normalised to sum 1 |
+//! | `/emotion/list` | `,` | control | answered with `/emotion/list/confirm`: `i` k, k × `i` emotion components, then per emotion `s` name and k × `f` levels |
 //! | `/emotion/alpha` | `,if` | control | raw translate of component i |
 //! | `/component/gain` | `,if` | control | gain of component i |
 //! | `/bypass` | `,i` | control | non-zero: pass frames through unedited |
@@ -113,8 +115,8 @@ pub use output::{
     FlatSplit, PartHeader, ETHERNET_PAYLOAD,
 };
 pub use reply::{
-    decode_reply, encode_confirm_into, encode_control_into, encode_error_into, encode_status_into,
-    Reply,
+    decode_reply, encode_confirm_into, encode_control_into, encode_emotion_list_into,
+    encode_error_into, encode_status_into, EmotionList, Reply,
 };
 pub use rosc;
 pub use scan::{

@@ -11,9 +11,20 @@ use crate::address as a;
 use crate::control::{decode_osc, parse_control, Control, ControlError};
 use crate::error::DecodeError;
 
+/// The emotion space a daemon's model holds, as `/emotion/list/confirm` carries it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EmotionList {
+    /// The emotion components (the space's axes).
+    pub components: Vec<u32>,
+    /// Each emotion's name and level vector over `components`.
+    pub emotions: Vec<(String, Vec<f32>)>,
+}
+
 /// A decoded reply from the daemon.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Reply {
+    /// `/emotion/list/confirm`: the emotion names and their level vectors.
+    EmotionList(EmotionList),
     /// `<address>/confirm` of an accepted control, with its echoed arguments.
     Confirm(Control),
     /// `/status/confirm`: counters as (name, value) pairs, in the daemon's order.
@@ -76,6 +87,25 @@ pub fn encode_status_into<S: AsRef<str>>(counters: &[(S, i64)], out: &mut Vec<u8
     encode_message(format!("{}{}", a::STATUS, a::CONFIRM_SUFFIX), args, out)
 }
 
+/// Encodes `/emotion/list/confirm`: `i` the number of emotion components `k`, `k` × `i` their
+/// indices, then for each emotion its name (`s`) and `k` × `f` levels. Returns the length.
+pub fn encode_emotion_list_into(list: &EmotionList, out: &mut Vec<u8>) -> usize {
+    let k = list.components.len();
+    let mut args = Vec::with_capacity(1 + k + list.emotions.len() * (k + 1));
+    args.push(OscType::Int(k as i32));
+    args.extend(list.components.iter().map(|&c| OscType::Int(c as i32)));
+    for (name, levels) in &list.emotions {
+        args.push(OscType::String(osc_string(name)));
+        args.extend(levels.iter().take(k).map(|&v| OscType::Float(v)));
+        args.extend((levels.len()..k).map(|_| OscType::Float(0.0)));
+    }
+    encode_message(
+        format!("{}{}", a::EMOTION_LIST, a::CONFIRM_SUFFIX),
+        args,
+        out,
+    )
+}
+
 /// Encodes `/emoshift/error ,ss` (address of the refused message, why). Returns the length.
 pub fn encode_error_into(address: &str, message: &str, out: &mut Vec<u8>) -> usize {
     let args = vec![
@@ -105,7 +135,45 @@ pub fn decode_reply(msg: &[u8]) -> Result<Reply, ControlError> {
     if base == a::STATUS {
         return parse_status(m.args).map(Reply::Status);
     }
+    if base == a::EMOTION_LIST {
+        return parse_emotion_list(m.args)
+            .map(Reply::EmotionList)
+            .ok_or_else(|| DecodeError::WrongTypeTags.into());
+    }
     parse_control(base, m.args).map(Reply::Confirm)
+}
+
+fn parse_emotion_list(args: Vec<OscType>) -> Option<EmotionList> {
+    let mut it = args.into_iter();
+    let OscType::Int(k) = it.next()? else {
+        return None;
+    };
+    let k = usize::try_from(k).ok()?;
+    let mut components = Vec::with_capacity(k.min(64));
+    for _ in 0..k {
+        let OscType::Int(c) = it.next()? else {
+            return None;
+        };
+        components.push(u32::try_from(c).ok()?);
+    }
+    let mut emotions = Vec::new();
+    while let Some(name) = it.next() {
+        let OscType::String(name) = name else {
+            return None;
+        };
+        let mut levels = Vec::with_capacity(k);
+        for _ in 0..k {
+            let OscType::Float(v) = it.next()? else {
+                return None;
+            };
+            levels.push(v);
+        }
+        emotions.push((name, levels));
+    }
+    Some(EmotionList {
+        components,
+        emotions,
+    })
 }
 
 fn parse_status(args: Vec<OscType>) -> Result<Vec<(String, i64)>, ControlError> {

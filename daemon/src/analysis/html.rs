@@ -66,6 +66,27 @@ fn quality_section(q: &ica_core::quality::ModelQuality) -> String {
     out
 }
 
+/// The emotion space: the map (when there is one), the level table and the notes on emotions
+/// that cannot be told apart; the main component's levels without a space.
+fn space_section(report: &Report, levels: &str) -> String {
+    let Some(space) = report.space.as_ref().filter(|s| !s.components.is_empty()) else {
+        return format!("<ul>{levels}</ul>");
+    };
+    let comps: Vec<String> = space.components.iter().map(|k| format!("c{k}")).collect();
+    let axes: Vec<String> = space.axes.iter().map(|k| format!("c{k}")).collect();
+    format!(
+        r#"<p>Components whose take levels differ between emotions (blocked F test over the
+paired takes, p &lt; 0.001 over all components): {}; emotion axes (emotions explain at least
+half of their levels): {}. Each emotion is a point in this space: the mean over its takes ± the
+spread across them. Edits move every one of these components.</p>
+<img src="emotion_map.svg" alt="emotion map: takes and emotion levels in the plane of the two strongest emotion directions">
+{}"#,
+        comps.join(", "),
+        axes.join(", "),
+        super::map::level_table(report)
+    )
+}
+
 /// Escapes text for HTML.
 fn esc(text: &str) -> String {
     text.replace('&', "&amp;")
@@ -132,7 +153,8 @@ Bars are coloured by the role given.</p>
 (shaded backgrounds). The emotion component jumps between levels when the emotion changes; speech
 components follow the words.</p>
 <img src="timeline.svg" alt="component series over alternating-emotion takes">
-<h2>Levels</h2><ul>{levels}</ul>
+<h2>Emotion space</h2>
+{space}
 <h2>Metrics</h2>
 <table><tr><th>component</th><th>role</th><th>d_emotion</th><th>d_level</th>{header}<th>|M_k| mm</th></tr>{rows}</table>
 {quality}
@@ -145,6 +167,7 @@ largest; else other.</p>
         model = report.model,
         manifest = report.manifest,
         quality = quality_section(&report.quality),
+        space = space_section(report, &levels),
         m = report.components.len(),
         pairs = report.pairs.len(),
         r1 = t.emotion_peak_ratio,

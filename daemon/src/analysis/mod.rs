@@ -2,15 +2,16 @@
 //!
 //! Every take of the manifest is projected onto the model. Pairs of takes with the same
 //! sentence and different emotions give `d_emotion` (DTW-aligned RMS difference per component,
-//! the method's metric, reported and charted) and `d_level` (RMS difference of take means); the
-//! clear peak of `d_level` is the emotion component. The two agree when few components are kept;
-//! `d_level` stays clear when the variance target keeps noise components, whose `d_emotion` is
-//! about √2 because noise is independent between takes. Region metrics `d_region,i` on the mouth, eyebrows and
-//! eyelids label the speech, eyebrow and eyelid components (thresholds in
-//! [`ica_core::interpret::LabelRules`]). Each named emotion gets a level: the mean of the emotion
-//! component over that emotion's takes.
+//! the method's metric, reported and charted) and `d_level` (RMS difference of take means).
+//! The emotion components are those whose take levels differ between emotions, by a blocked F
+//! test across the paired takes ([`space`]): emotion is a space, not one axis, and each named
+//! emotion gets a point in it (the mean over its takes, with the spread). Region metrics
+//! `d_region,i` on the mouth, eyebrows and eyelids label the speech, eyebrow and eyelid
+//! components (thresholds in [`ica_core::interpret::LabelRules`]).
 
 mod html;
+mod map;
+pub mod space;
 mod svg;
 
 use std::collections::BTreeMap;
@@ -78,6 +79,8 @@ pub struct ComponentReport {
     pub d_region: BTreeMap<String, f64>,
     /// Marker-space displacement of one unit of the component (mm, mixing column norm).
     pub mixing_norm_mm: f64,
+    /// The emotion effect on the component's take levels (absent without pairs).
+    pub emotion_effect: Option<ica_core::interpret::EmotionEffect>,
 }
 
 /// The whole analysis, written as `report.json`.
@@ -95,8 +98,10 @@ pub struct Report {
     pub emotion_measured: bool,
     /// Why emotion was not measured or no clear peak was found (empty when it was).
     pub emotion_note: String,
-    /// Level of the emotion component per emotion name.
+    /// Level of the main emotion component per emotion name.
     pub levels: BTreeMap<String, f64>,
+    /// The emotion space: components, each emotion's point, emotions that cannot be told apart.
+    pub space: Option<space::EmotionSpace>,
     /// Pairs used for `d_emotion`.
     pub pairs: Vec<PairSummary>,
     /// Takes analysed.
@@ -229,10 +234,21 @@ pub fn analyze(
             .collect();
         (Some(d.per_component), Some(level), summaries)
     };
-    let emotion = d_level
-        .as_deref()
-        .map(|d| interpret::emotion_components(d, &rules))
-        .unwrap_or_default();
+    let space = (!pairs.is_empty()).then(|| {
+        let levels: Vec<space::TakeLevel> = takes
+            .iter()
+            .zip(&series)
+            .map(|(t, s)| space::TakeLevel {
+                sentence: t.sentence.clone(),
+                emotion: t.emotion.clone(),
+                means: take_means(s, m),
+            })
+            .collect();
+        space::emotion_space(&levels, m)
+    });
+    // Region metrics and roles treat the emotion axes as the emotion set; components that only
+    // shift a little with emotion keep their region role.
+    let emotion = space.as_ref().map(|s| s.axes.clone()).unwrap_or_default();
     let all: Vec<&[f64]> = series.iter().map(Vec::as_slice).collect();
     let mut d_region = BTreeMap::new();
     for (name, markers) in regions {
@@ -244,17 +260,25 @@ pub fn analyze(
         .filter_map(|(name, role)| d_region.get(*name).map(|d| (*role, d.as_slice())))
         .collect();
     let roles = interpret::label(m, &emotion, &role_inputs, &rules);
-    let levels = emotion_levels(
-        takes,
-        &series,
-        m,
-        main_emotion(&emotion, d_emotion.as_deref()),
-    );
+    let levels: BTreeMap<String, f64> = match &space {
+        Some(sp) => match sp.components.iter().position(|&k| Some(k) == sp.main) {
+            Some(at) => sp
+                .points
+                .iter()
+                .map(|(n, p)| (n.clone(), p.level[at]))
+                .collect(),
+            None => BTreeMap::new(),
+        },
+        None => BTreeMap::new(),
+    };
     let emotion_note = match (&d_emotion, emotion.is_empty()) {
         (None, _) => "emotion not measured: the manifest has no pair of takes with the same \
                       sentence in two different emotions"
             .to_string(),
-        (Some(_), true) => "no clear peak in d_level: no component is labelled emotion".into(),
+        (Some(_), true) => format!(
+            "no component's take levels differ between emotions (F test at p < {} over {m} components): no component is labelled emotion",
+            interpret::EMOTION_ALPHA
+        ),
         (Some(_), false) => String::new(),
     };
     let components = (0..m)
@@ -265,6 +289,7 @@ pub fn analyze(
             d_level: d_level.as_ref().map(|d| d[k]),
             d_region: d_region.iter().map(|(n, d)| (n.clone(), d[k])).collect(),
             mixing_norm_mm: model.mixing().column(k).norm(),
+            emotion_effect: space.as_ref().map(|s| s.effects[k]),
         })
         .collect();
     Ok(Report {
@@ -275,6 +300,7 @@ pub fn analyze(
         emotion_measured: d_emotion.is_some(),
         emotion_note,
         levels,
+        space,
         pairs: pair_summaries,
         takes: takes
             .iter()
@@ -304,52 +330,38 @@ pub fn analyze(
     })
 }
 
-/// The emotion component the levels are measured on: the largest `d_level` among the peaks.
-fn main_emotion(emotion: &[usize], d: Option<&[f64]>) -> Option<usize> {
-    let d = d?;
-    emotion
-        .iter()
-        .copied()
-        .max_by(|&a, &b| d[a].total_cmp(&d[b]))
-}
-
-fn emotion_levels(
-    takes: &[SessionTake],
-    series: &[Vec<f64>],
-    m: usize,
-    k: Option<usize>,
-) -> BTreeMap<String, f64> {
-    let Some(k) = k else { return BTreeMap::new() };
-    let mut by_emotion: BTreeMap<String, Vec<&[f64]>> = BTreeMap::new();
-    for (t, s) in takes.iter().zip(series) {
-        by_emotion.entry(t.emotion.clone()).or_default().push(s);
+/// The mean of each component over a take (frames x m series).
+fn take_means(series: &[f64], m: usize) -> Vec<f64> {
+    let frames = (series.len() / m.max(1)).max(1) as f64;
+    let mut means = vec![0.0; m];
+    for row in series.chunks_exact(m) {
+        for (acc, v) in means.iter_mut().zip(row) {
+            *acc += v / frames;
+        }
     }
-    by_emotion
-        .into_iter()
-        .filter_map(|(name, s)| interpret::component_mean(&s, m, k).map(|v| (name, v)))
-        .collect()
+    means
 }
 
-/// Stores roles, the emotion component and its levels in the model.
+/// Stores roles and the emotion space (components, main component, points) in the model.
 ///
 /// # Errors
 /// A component index outside the model (an internal invariant).
 pub fn write_into_model(model: &mut IcaModel, report: &Report) -> Result<()> {
+    match &report.space {
+        Some(space) if !space.components.is_empty() => {
+            let main = space.main.expect("a non-empty space has a main component");
+            model.set_emotion_space(
+                space.components.clone(),
+                main,
+                space.points.clone(),
+                space.persistence.clone(),
+            )?;
+        }
+        _ => model.clear_emotion_space(),
+    }
+    // After the space: its components that are not emotion axes keep their region role.
     for c in &report.components {
         model.set_role(c.index, c.role)?;
-    }
-    let main = main_emotion(
-        &report.emotion_components,
-        report
-            .components
-            .iter()
-            .map(|c| c.d_level)
-            .collect::<Option<Vec<f64>>>()
-            .as_deref(),
-    );
-    model.set_emotion_component(main)?;
-    for (name, level) in &report.levels {
-        model.set_emotion_level(name, *level)?;
     }
     Ok(())
 }
@@ -368,10 +380,15 @@ pub fn write_report(dir: &Path, report: &Report, takes: &[SessionTake]) -> Resul
     let json = serde_json::to_string_pretty(report).context("report serialisation")?;
     let components = svg::components_chart(report);
     let timeline = svg::timeline_chart(report, takes);
-    Ok(vec![
+    let mut written = Vec::new();
+    if let Some(map) = map::emotion_map(report) {
+        written.push(write("emotion_map.svg", map)?);
+    }
+    written.extend([
         write("report.json", json)?,
         write("components.svg", components)?,
         write("timeline.svg", timeline)?,
         write("report.html", html::page(report))?,
-    ])
+    ]);
+    Ok(written)
 }

@@ -3,8 +3,8 @@
 //! 1. a paired synthetic session (or, with `--real`, the bundled Facial-Sing capture);
 //! 2. train and analyse a model (progress and summaries as `train` and `analyze` print them);
 //! 3. the daemon on loopback (ephemeral ports), in this process;
-//! 4. a neutral take replayed into it at its rate while the emotion sweeps from one named
-//!    emotion to another over OSC control (no sweep without emotion pairs);
+//! 4. a neutral take replayed into it at its rate while the emotion sweeps through named
+//!    emotions of the model's emotion space over OSC control (no sweep without emotion pairs);
 //! 5. a client subscribed with the compact profile receives the edited stream;
 //! 6. a summary: frames, loss, latency percentiles, the emotion state seen, the components and
 //!    their roles, and the path of the HTML report.
@@ -34,12 +34,11 @@ use crate::serve;
 const FACIAL_SING: &[u8] = include_bytes!("../../../replay/tests/fixtures/Facial-Sing.c3d");
 const FACIAL_SING_REGIONS: &str = include_str!("../../tests/fixtures/facial-sing.regions.toml");
 
-/// Sentences of the demo session: 8 x 3 emotions, about 8,500 frames at 120 Hz.
+/// Sentences of the demo session: 8 x 4 emotions over 2 emotion directions, about 13,000
+/// frames at 120 Hz.
 const SENTENCES: usize = 8;
 /// Seconds of live streaming (the take loops).
-const STREAM_S: f64 = 8.0;
-/// Components of the demo model: the generator's seven facial sources and one to spare.
-const COMPONENTS: usize = 8;
+const STREAM_S: f64 = 12.0;
 
 fn step(n: usize, text: &str) -> Result<()> {
     crate::out!("\n== {n}/5 {text}");
@@ -84,7 +83,7 @@ struct Session {
     regions: Option<PathBuf>,
     take: PathBuf,
     components: Option<usize>,
-    sweep: Option<(String, String)>,
+    sweep: Option<Vec<String>>,
 }
 
 fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
@@ -97,7 +96,7 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
     } else {
         step(
             1,
-            "a paired synthetic session (8 sentences x neutral, happy, frustrated)",
+            "a paired synthetic session (8 sentences x neutral, happy, sad, angry over 2 emotion directions)",
         )?;
         synthetic_session(dir, args.seed)?
     };
@@ -145,6 +144,11 @@ fn synthetic_session(dir: &Path, seed: u64) -> Result<Session> {
     let params = SynthParams {
         seed,
         sentences: SENTENCES,
+        emotions: ["neutral", "happy", "sad", "angry"]
+            .iter()
+            .map(|e| e.to_string())
+            .collect(),
+        emotion_dims: 2,
         ..SynthParams::default()
     };
     let s = dir.join("session");
@@ -161,8 +165,8 @@ fn synthetic_session(dir: &Path, seed: u64) -> Result<Session> {
         manifest: summary.manifest,
         regions: None,
         take: s.join("s01_neutral.c3d"),
-        components: Some(COMPONENTS),
-        sweep: Some(("frustrated".into(), "happy".into())),
+        components: None,
+        sweep: Some(vec!["sad".into(), "happy".into(), "angry".into()]),
     })
 }
 
@@ -201,20 +205,23 @@ struct Seen {
 }
 
 /// The live run's measurements.
+/// What the client saw at one frame: time (s), target, amount, and the emotion components.
+type State = (f64, String, f32, Option<Vec<f32>>);
+
 struct Live {
     sent: usize,
     received: usize,
     latencies_us: Vec<f64>,
-    states: Vec<(f64, String, f32, Option<f32>)>,
+    states: Vec<State>,
     late_sends: u64,
-    sweep: Option<(String, String)>,
+    sweep: Option<Vec<String>>,
 }
 
 fn stream(
     model_path: &Path,
     model: &IcaModel,
     take: &Take,
-    sweep: Option<&(String, String)>,
+    sweep: Option<&Vec<String>>,
 ) -> Result<Live> {
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -270,19 +277,19 @@ fn stream(
     let mut latencies_us = Vec::new();
     let mut states = Vec::new();
     let start = sent.first_send;
-    // The emotion component of what the client received, to show the sweep in model units.
+    // The emotion components of what the client received, to show the sweep in model units.
     let mut processor = crate::frame::FrameProcessor::new(model);
     let mut u = vec![0.0f32; model.components()];
-    let emotion = model.emotion().component;
+    let space = model.emotion().space_components();
     for (number, s) in seen.iter() {
         if let Some(at) = sent.sent_at.get(&(*number as i64)) {
             latencies_us.push(s.received.duration_since(*at).as_secs_f64() * 1e6);
         }
-        let value = match emotion {
-            Some(k) if s.missing.len() == model.markers() => processor
+        let value = match space.is_empty() {
+            false if s.missing.len() == model.markers() => processor
                 .project(&s.positions, &s.missing, &mut u)
                 .ok()
-                .map(|_| u[k]),
+                .map(|_| space.iter().map(|&k| u[k]).collect::<Vec<f32>>()),
             _ => None,
         };
         let t = s.received.duration_since(start).as_secs_f64();
@@ -334,7 +341,7 @@ fn send_take(
     to: SocketAddr,
     client: &UdpSocket,
     control_to: SocketAddr,
-    sweep: Option<&(String, String)>,
+    sweep: Option<&Vec<String>>,
 ) -> Result<Sent> {
     let socket = UdpSocket::bind("127.0.0.1:0")?;
     let mut labels = Vec::new();
@@ -347,18 +354,15 @@ fn send_take(
     )?;
     let frames = take.n_frames();
     let duration_s = (frames as f64 / take.rate_hz).max(STREAM_S);
-    if let Some((from, _)) = sweep {
-        // Glide over half the take towards `from`, then over the other half towards `to`.
-        control(
-            client,
-            control_to,
-            &Control::Ramp((duration_s / 2.0) as f32),
-        )?;
-        control(client, control_to, &Control::Target(from.clone()))?;
+    if let Some(targets) = sweep {
+        // Glide towards each target in turn, one equal share of the stream each.
+        let share = duration_s / targets.len().max(1) as f64;
+        control(client, control_to, &Control::Ramp(share as f32))?;
+        control(client, control_to, &Control::Target(targets[0].clone()))?;
         control(client, control_to, &Control::Amount(1.0))?;
         crate::out!(
-            "sweep: towards {from} over {:.1} s, then the other way",
-            duration_s / 2.0
+            "sweep: towards {} in turn, {share:.1} s each",
+            targets.join(", then ")
         );
     }
     let options = PacerOptions {
@@ -378,7 +382,7 @@ fn send_take(
     let mut datagram = Vec::with_capacity(protocol::frame_message_len(take.n_markers()));
     let mut sent_at = std::collections::HashMap::with_capacity(frames);
     let origin = Instant::now();
-    let mut switched = false;
+    let mut next_target = 1usize;
     loop {
         match pacer.poll(origin.elapsed()) {
             Action::SendLabels => {
@@ -388,10 +392,12 @@ fn send_take(
                 if f.stream_index as usize >= total {
                     break;
                 }
-                if let (Some((_, target)), false) = (sweep, switched) {
-                    if f.stream_index as usize * 2 >= total {
-                        control(client, control_to, &Control::Target(target.clone()))?;
-                        switched = true;
+                if let Some(targets) = sweep {
+                    let at = next_target * total / targets.len().max(1);
+                    if next_target < targets.len() && f.stream_index as usize >= at {
+                        let target = targets[next_target].clone();
+                        control(client, control_to, &Control::Target(target))?;
+                        next_target += 1;
                     }
                 }
                 buf.set_frame(
@@ -510,24 +516,41 @@ fn summary(
         percentile(&lat, 0.999),
         percentile(&lat, 1.0)
     );
-    if let Some((from, to)) = &live.sweep {
-        crate::out!("emotion sweep {from} -> {to} as the client saw it (emotion component of the received markers, 0.5 s means):");
+    if let Some(targets) = &live.sweep {
+        let space: Vec<String> = model
+            .emotion()
+            .space_components()
+            .iter()
+            .map(|k| format!("c{k}"))
+            .collect();
+        crate::out!(
+            "emotion sweep {} as the client saw it (emotion components {} of the received markers, 0.5 s means):",
+            targets.join(" -> "),
+            space.join(" ")
+        );
         let end = live.states.last().map_or(0.0, |s| s.0);
         let mut t0 = 0.0;
         while t0 < end {
-            let window: Vec<&(f64, String, f32, Option<f32>)> = live
+            let window: Vec<&State> = live
                 .states
                 .iter()
                 .filter(|s| s.0 >= t0 && s.0 < t0 + 0.5)
                 .collect();
-            let values: Vec<f32> = window.iter().filter_map(|s| s.3).collect();
+            let values: Vec<&Vec<f32>> = window.iter().filter_map(|s| s.3.as_ref()).collect();
             if let (Some(last), false) = (window.last(), values.is_empty()) {
-                let mean = values.iter().sum::<f32>() / values.len() as f32;
+                let dims = values[0].len();
+                let mean: Vec<String> = (0..dims)
+                    .map(|j| {
+                        let m = values.iter().map(|v| v[j]).sum::<f32>() / values.len() as f32;
+                        format!("{m:+.3}")
+                    })
+                    .collect();
                 crate::out!(
-                    "  t {t0:4.1}-{:4.1} s  target {:<10} amount {:.2}  emotion {mean:+.3}",
+                    "  t {t0:4.1}-{:4.1} s  target {:<10} amount {:.2}  emotion {}",
                     t0 + 0.5,
                     last.1,
-                    last.2
+                    last.2,
+                    mean.join(" ")
                 );
             }
             t0 += 0.5;
@@ -541,8 +564,12 @@ fn summary(
             model.mixing().column(k).norm()
         );
     }
-    for (name, level) in &model.emotion().levels {
-        crate::out!("  level {name}: {level:.3}");
+    let e = model.emotion();
+    for name in e.names() {
+        if let Some(point) = e.point(&name) {
+            let p: Vec<String> = point.iter().map(|v| format!("{v:+.3}")).collect();
+            crate::out!("  emotion {name}: {}", p.join(" "));
+        }
     }
     crate::out!("report: {}", report.display());
     crate::out!("demo finished in {:.1} s", started.elapsed().as_secs_f64());

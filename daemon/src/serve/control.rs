@@ -11,7 +11,8 @@ use std::time::Duration;
 use crossbeam_channel::Sender;
 use ica_core::model::IcaModel;
 use protocol::{
-    decode_control, encode_confirm_into, encode_error_into, encode_status_into, Control,
+    decode_control, encode_confirm_into, encode_emotion_list_into, encode_error_into,
+    encode_status_into, Control, EmotionList,
 };
 use tokio::net::UdpSocket;
 use tokio::sync::oneshot;
@@ -46,6 +47,8 @@ pub(crate) struct ControlCtx {
     pub(crate) cmd_tx: Sender<Cmd>,
     pub(crate) stats: Arc<Mutex<Stats>>,
     pub(crate) model_path: Arc<Mutex<PathBuf>>,
+    /// The default model now (for `/emotion/list`).
+    pub(crate) model: Arc<Mutex<Arc<IcaModel>>>,
     pub(crate) tracker: TaskTracker,
 }
 
@@ -87,6 +90,22 @@ pub(crate) async fn run(ctx: ControlCtx, shutdown: CancellationToken) {
     }
 }
 
+/// The emotion space of a model as `/emotion/list/confirm` carries it.
+fn emotion_list(model: &IcaModel) -> EmotionList {
+    let e = model.emotion();
+    EmotionList {
+        components: e.space_components().iter().map(|&k| k as u32).collect(),
+        emotions: e
+            .names()
+            .into_iter()
+            .filter_map(|n| {
+                let p = e.point(&n)?;
+                Some((n, p.iter().map(|&v| v as f32).collect()))
+            })
+            .collect(),
+    }
+}
+
 /// The address of a refused message, for the error reply (empty when unreadable).
 fn refused_address(bytes: &[u8]) -> String {
     protocol::messages(bytes, &protocol::Limits::default())
@@ -103,6 +122,18 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
         let mut out = Vec::with_capacity(2048);
         encode_status_into(&pairs, &mut out);
         send(ctx, peer, &out).await;
+        return;
+    }
+    if control == Control::EmotionList {
+        let list = ctx.model.lock().map(|m| emotion_list(&m)).ok();
+        let mut out = Vec::with_capacity(2048);
+        match list {
+            Some(list) => {
+                encode_emotion_list_into(&list, &mut out);
+                send(ctx, peer, &out).await;
+            }
+            None => reply(ctx, peer, address, Err("model unavailable".into())).await,
+        }
         return;
     }
     let result = match &control {
@@ -145,9 +176,13 @@ async fn reload(ctx: &ControlCtx, path: PathBuf) -> Result<(), String> {
     let model = super::server::load_model(path.clone())
         .await
         .map_err(|e| format!("{e:#}"))?;
-    ask(ctx, |tx| Cmd::SetModel(Arc::new(model), tx)).await?;
+    let model = Arc::new(model);
+    ask(ctx, |tx| Cmd::SetModel(Arc::clone(&model), tx)).await?;
     if let Ok(mut p) = ctx.model_path.lock() {
         *p = path.clone();
+    }
+    if let Ok(mut m) = ctx.model.lock() {
+        *m = model;
     }
     tracing::info!(path = %path.display(), "model swapped in");
     Ok(())

@@ -2,17 +2,24 @@
 //! from frame numbers and the model rate), never on the wall clock, so a test or an offline run
 //! sees exactly what the daemon does.
 //!
-//! The edit, for the emotion component `E`:
-//! `u_E' = u_E + amount · (level[target] − lowpass(u_E))`, with a one-pole low-pass whose time
-//! constant is the window (default 1 s): the slow emotion drift is moved, the fast speech motion
-//! of the same component is kept. Raw alpha (`u_k + alpha_k`), gains (`g_k · u_k`) and bypass
+//! The edit, for every emotion component `E` of the model's emotion space (one or more):
+//! `u_E' = u_E + amount · (target_E − lowpass(u_E))`, where `target` is the point of the target
+//! emotion (or of a blend) in that space, and the one-pole low-pass has the window as time
+//! constant (default 1 s): the slow emotion level is moved, the fast speech motion of the same
+//! components is kept. Raw alpha (`u_k + alpha_k`), gains (`g_k · u_k`) and bypass
 //! complete it; with amount 0 and no bypass the result is bit-for-bit `FrameEdit::apply`
 //! (`u · g + alpha`), so the live and offline edits agree.
+//!
+//! `target` keeps the part of each component's level that belongs to what is said (see
+//! [`SpaceTarget`]): a component that carries emotion alone goes to the target's level, one
+//! whose level also follows the sentence keeps its own offset from the source emotion.
 //!
 //! Every setting glides from its current value to the new one over the ramp (default 0.25 s)
 //! on a smoothstep curve (`3t² − 2t³`): value and slope are continuous at both ends, so no
 //! setting change makes a step (a "pop") in the markers. A change during a glide starts from
 //! where the glide is.
+
+use ica_core::model::SpaceTarget;
 
 /// Default ramp of a new setting (seconds).
 pub const DEFAULT_RAMP_S: f32 = 0.25;
@@ -95,32 +102,73 @@ pub enum EditRefused {
         /// Name received.
         name: String,
     },
+    /// A target point with a number of levels other than the emotion space's dimensions.
+    #[error("a target of {got} levels for an emotion space of {expected}")]
+    Dims {
+        /// Dimensions of the space.
+        expected: usize,
+        /// Levels given.
+        got: usize,
+    },
 }
 
 /// The live edit of one stream. Call order per frame: [`EditState::apply`] with the frame's
 /// `dt_s`; settings (`set_*`) between frames.
 #[derive(Debug, Clone)]
 pub struct EditState {
-    emotion: Option<usize>,
+    /// The emotion components (the space's axes).
+    emotion: Vec<usize>,
     target: String,
-    level: Glide,
+    /// The target point, one glide per emotion component.
+    level: Vec<Glide>,
     amount: Glide,
     alpha: Vec<Glide>,
     gains: Vec<Glide>,
     wet: Glide,
     ramp_s: f32,
     lowpass_s: f32,
-    lowpass: Option<f32>,
+    /// Low-pass of each emotion component; `None` before the first frame.
+    lowpass: Option<Vec<f32>>,
+    /// Preallocated storage for `lowpass` (moved in on the first frame, no allocation).
+    lowpass_buf: Vec<f32>,
+    /// Where each emotion component goes to reach the target point (sentence share kept).
+    space: SpaceTarget,
+    /// The target point now (glide values), and the levels to move to; per emotion component.
+    goal: Vec<f32>,
+    to: Vec<f32>,
     raw: Vec<f32>,
 }
 
 impl EditState {
-    /// An identity edit for `components` components; `emotion` is the emotion component.
-    pub fn new(components: usize, emotion: Option<usize>, lowpass_s: f32) -> EditState {
+    /// An identity edit for `components` components; `emotion` are the emotion components
+    /// (empty: the model has none). Components out of range are ignored.
+    pub fn new(components: usize, emotion: &[usize], lowpass_s: f32) -> EditState {
+        let emotion: Vec<usize> = emotion
+            .iter()
+            .copied()
+            .filter(|&k| k < components)
+            .collect();
+        let levels = ica_core::model::EmotionLevels {
+            components: emotion.clone(),
+            ..Default::default()
+        };
+        EditState::with_space(components, emotion, SpaceTarget::new(&levels), lowpass_s)
+    }
+
+    fn with_space(
+        components: usize,
+        emotion: Vec<usize>,
+        space: SpaceTarget,
+        lowpass_s: f32,
+    ) -> EditState {
         EditState {
+            space,
+            goal: vec![0.0; emotion.len()],
+            to: vec![0.0; emotion.len()],
+            target: String::with_capacity(64),
+            level: vec![Glide::settled(0.0); emotion.len()],
+            lowpass_buf: vec![0.0; emotion.len()],
             emotion,
-            target: String::with_capacity(32),
-            level: Glide::settled(0.0),
             amount: Glide::settled(0.0),
             alpha: vec![Glide::settled(0.0); components],
             gains: vec![Glide::settled(1.0); components],
@@ -130,6 +178,21 @@ impl EditState {
             lowpass: None,
             raw: vec![0.0; components],
         }
+    }
+
+    /// The edit for a model: its components and emotion space (points, spreads and
+    /// persistence included).
+    pub fn for_model(model: &ica_core::IcaModel, lowpass_s: f32) -> EditState {
+        let space = model.emotion().space_components();
+        if space.iter().any(|&k| k >= model.components()) {
+            return EditState::new(model.components(), &[], lowpass_s);
+        }
+        EditState::with_space(
+            model.components(),
+            space,
+            SpaceTarget::new(model.emotion()),
+            lowpass_s,
+        )
     }
 
     /// The target emotion (empty before one is set).
@@ -147,17 +210,27 @@ impl EditState {
         self.ramp_s = ramp_s.max(0.0);
     }
 
-    /// Sets the target emotion, whose `level` the caller looked up in the model.
+    /// Sets the target: its name (an emotion, or a blend's description) and its point in the
+    /// emotion space, which the caller looked up in the model.
     ///
     /// # Errors
-    /// [`EditRefused::NoEmotion`] when the model has no emotion component.
-    pub fn set_target(&mut self, name: &str, level: f32) -> Result<(), EditRefused> {
-        if self.emotion.is_none() {
+    /// [`EditRefused::NoEmotion`] when the model has no emotion component,
+    /// [`EditRefused::Dims`] for a point of the wrong length.
+    pub fn set_target(&mut self, name: &str, point: &[f32]) -> Result<(), EditRefused> {
+        if self.emotion.is_empty() {
             return Err(EditRefused::NoEmotion);
+        }
+        if point.len() != self.level.len() {
+            return Err(EditRefused::Dims {
+                expected: self.level.len(),
+                got: point.len(),
+            });
         }
         self.target.clear();
         self.target.push_str(name);
-        self.level.set(level, self.ramp_s);
+        for (g, &p) in self.level.iter_mut().zip(point) {
+            g.set(p, self.ramp_s);
+        }
         Ok(())
     }
 
@@ -166,7 +239,7 @@ impl EditState {
     /// # Errors
     /// [`EditRefused::NoEmotion`] when the model has no emotion component.
     pub fn set_amount(&mut self, amount: f32) -> Result<(), EditRefused> {
-        if self.emotion.is_none() {
+        if self.emotion.is_empty() {
             return Err(EditRefused::NoEmotion);
         }
         self.amount.set(amount, self.ramp_s);
@@ -224,13 +297,8 @@ impl EditState {
         for ((ui, g), a) in u.iter_mut().zip(&self.gains).zip(&self.alpha) {
             *ui = *ui * g.value() + a.value();
         }
-        if let Some(k) = self.emotion.filter(|&k| k < u.len()) {
-            let raw = if wet < 1.0 { self.raw[k] } else { u[k] };
-            let lp = self.update_lowpass(dt_s, raw);
-            let amount = self.amount.value();
-            if amount != 0.0 {
-                u[k] += amount * (self.level.value() - lp);
-            }
+        if !self.emotion.is_empty() && self.emotion.iter().all(|&k| k < u.len()) {
+            self.edit_emotion(dt_s, wet, u);
         }
         if wet < 1.0 {
             for (ui, r) in u.iter_mut().zip(&self.raw) {
@@ -240,22 +308,41 @@ impl EditState {
         self.advance(dt_s);
     }
 
-    /// One-pole low-pass of the emotion component (before the edit), started at its first value.
-    fn update_lowpass(&mut self, dt_s: f32, x: f32) -> f32 {
-        let y = match self.lowpass {
-            None => x,
-            Some(y) if self.lowpass_s <= 0.0 => {
-                let _ = y;
-                x
-            }
-            Some(y) => y + (x - y) * (dt_s / (self.lowpass_s + dt_s)),
+    /// Moves every emotion component towards the target from its low-pass (taken before the
+    /// edit: of the raw value when bypass is gliding).
+    fn edit_emotion(&mut self, dt_s: f32, wet: f32, u: &mut [f32]) {
+        let first = self.lowpass.is_none();
+        let mut lp = self
+            .lowpass
+            .take()
+            .unwrap_or_else(|| std::mem::take(&mut self.lowpass_buf));
+        let gain = if self.lowpass_s <= 0.0 {
+            1.0
+        } else {
+            dt_s / (self.lowpass_s + dt_s)
         };
-        self.lowpass = Some(y);
-        y
+        for (&k, y) in self.emotion.iter().zip(lp.iter_mut()) {
+            let x = if wet < 1.0 { self.raw[k] } else { u[k] };
+            // One-pole low-pass, started at the first value.
+            *y = if first { x } else { *y + (x - *y) * gain };
+        }
+        let amount = self.amount.value();
+        if amount != 0.0 {
+            for (g, level) in self.goal.iter_mut().zip(&self.level) {
+                *g = level.value();
+            }
+            self.space.target_into(&lp, &self.goal, &mut self.to);
+            for ((&k, y), to) in self.emotion.iter().zip(&lp).zip(&self.to) {
+                u[k] += amount * (to - y);
+            }
+        }
+        self.lowpass = Some(lp);
     }
 
     fn advance(&mut self, dt_s: f32) {
-        self.level.advance(dt_s);
+        for g in &mut self.level {
+            g.advance(dt_s);
+        }
         self.amount.advance(dt_s);
         self.wet.advance(dt_s);
         for g in self.alpha.iter_mut().chain(self.gains.iter_mut()) {
@@ -265,7 +352,9 @@ impl EditState {
 
     /// Forgets the low-pass history (a stream restarted).
     pub fn reset_lowpass(&mut self) {
-        self.lowpass = None;
+        if let Some(lp) = self.lowpass.take() {
+            self.lowpass_buf = lp;
+        }
     }
 
     /// Copies every setting (goals, settled) of `other` into `self`, for a new stream or a
@@ -274,9 +363,15 @@ impl EditState {
         self.ramp_s = other.ramp_s;
         self.target.clear();
         self.target.push_str(&other.target);
-        if self.emotion.is_some() && other.emotion.is_some() {
-            self.level = Glide::settled(other.level.goal());
+        // The target point carries over to a space of the same shape; the amount to any
+        // space (a new model's points differ, so the target is re-resolved by the caller).
+        if !self.emotion.is_empty() && !other.emotion.is_empty() {
             self.amount = Glide::settled(other.amount.goal());
+            if self.level.len() == other.level.len() {
+                for (a, b) in self.level.iter_mut().zip(&other.level) {
+                    *a = Glide::settled(b.goal());
+                }
+            }
         }
         self.wet = Glide::settled(other.wet.goal());
         for (a, b) in self.alpha.iter_mut().zip(&other.alpha) {
@@ -296,7 +391,7 @@ mod tests {
 
     #[test]
     fn settled_alpha_and_gain_equal_frame_edit_bit_for_bit() {
-        let mut e = EditState::new(3, None, 1.0);
+        let mut e = EditState::new(3, &[], 1.0);
         e.set_ramp(0.0);
         e.set_alpha(1, 1.5).expect("in range");
         e.set_gain(2, 0.5).expect("in range");
@@ -312,7 +407,7 @@ mod tests {
 
     #[test]
     fn a_ramp_glides_monotonically_and_arrives_on_time() {
-        let mut e = EditState::new(2, None, 1.0);
+        let mut e = EditState::new(2, &[], 1.0);
         e.set_ramp(0.25);
         e.set_alpha(0, 10.0).expect("in range");
         let mut prev = 0.0;
@@ -335,9 +430,9 @@ mod tests {
 
     #[test]
     fn emotion_edit_moves_the_slow_level_and_keeps_the_fast_motion() {
-        let mut e = EditState::new(1, Some(0), 1.0);
+        let mut e = EditState::new(1, &[0], 1.0);
         e.set_ramp(0.0);
-        e.set_target("happy", 5.0).expect("emotion component");
+        e.set_target("happy", &[5.0]).expect("emotion component");
         e.set_amount(1.0).expect("emotion component");
         let mut out = Vec::new();
         for f in 0..1200 {
@@ -359,7 +454,7 @@ mod tests {
 
     #[test]
     fn bypass_glides_back_to_the_input_and_refusals_name_the_value() {
-        let mut e = EditState::new(2, None, 1.0);
+        let mut e = EditState::new(2, &[], 1.0);
         e.set_ramp(0.0);
         e.set_alpha(0, 3.0).expect("in range");
         e.set_ramp(0.1);
@@ -380,5 +475,30 @@ mod tests {
             })
         );
         assert_eq!(e.set_amount(1.0), Err(EditRefused::NoEmotion));
+    }
+
+    #[test]
+    fn every_emotion_component_moves_to_its_coordinate_of_the_target() {
+        let mut e = EditState::new(3, &[0, 2], 0.5);
+        e.set_ramp(0.0);
+        assert_eq!(
+            e.set_target("sad", &[1.0]),
+            Err(EditRefused::Dims {
+                expected: 2,
+                got: 1
+            })
+        );
+        e.set_target("sad", &[2.0, -1.0]).expect("two levels");
+        e.set_amount(1.0).expect("emotion space");
+        let mut u = [0.0f32; 3];
+        for _ in 0..600 {
+            u = [0.3, 7.0, -0.2];
+            e.apply(DT, &mut u);
+        }
+        assert!(
+            (u[0] - 2.0).abs() < 1e-3 && (u[2] + 1.0).abs() < 1e-3,
+            "{u:?}"
+        );
+        assert_eq!(u[1], 7.0, "components outside the space are left alone");
     }
 }

@@ -129,6 +129,7 @@ impl Bound {
         let (free_tx, free_rx) = crossbeam_channel::bounded::<Vec<u8>>(POOL);
         let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Cmd>(64);
 
+        let current_model = Arc::new(Mutex::new(Arc::clone(&self.model)));
         let pipeline = Pipeline::new(
             self.model,
             self.performers,
@@ -164,6 +165,7 @@ impl Bound {
             cmd_tx,
             stats: Arc::clone(&stats),
             model_path: Arc::new(Mutex::new(self.config.model.clone())),
+            model: current_model,
             tracker: tracker.clone(),
         };
         tracker.spawn(control::run(ctx.clone(), shutdown.clone()));

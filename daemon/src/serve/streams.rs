@@ -162,7 +162,7 @@ impl Stream {
         let m = model.components();
         Ok(Stream {
             processor: FrameProcessor::new(&model),
-            edit: EditState::new(m, model.emotion().component, lowpass_s),
+            edit: EditState::for_model(&model, lowpass_s),
             map,
             take_missing: vec![false; source_labels.len()],
             xyz: vec![0.0; n * 3],

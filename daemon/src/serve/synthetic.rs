@@ -50,6 +50,31 @@ pub fn random_model(markers: usize, components: usize, seed: u64) -> IcaModel {
     model
 }
 
+/// [`random_model`] with a two-dimensional emotion space on components 0 and 2: `neutral`
+/// (0, 0), `happy` (2, 0), `sad` (−1, −1.5), `angry` (−1, 1.5), spread 0.2 each, and
+/// component 2 persisting half its sentence offset.
+pub fn random_space_model(markers: usize, components: usize, seed: u64) -> IcaModel {
+    let mut model = random_model(markers, components, seed);
+    let point = |a: f64, b: f64| ica_core::model::EmotionPoint {
+        level: vec![a, b],
+        spread: vec![0.2, 0.2],
+        takes: 4,
+    };
+    let points = [
+        ("neutral", point(0.0, 0.0)),
+        ("happy", point(2.0, 0.0)),
+        ("sad", point(-1.0, -1.5)),
+        ("angry", point(-1.0, 1.5)),
+    ]
+    .into_iter()
+    .map(|(n, p)| (n.to_string(), p))
+    .collect();
+    model
+        .set_emotion_space(vec![0, 2], 0, points, vec![0.0, 0.5])
+        .expect("components 0 and 2 exist");
+    model
+}
+
 /// The `/mocap/labels` datagram announcing `model`'s markers as layout 0, as a source would.
 ///
 /// # Errors

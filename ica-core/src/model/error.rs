@@ -147,8 +147,9 @@ pub enum ModelError {
         /// Components in the model.
         components: usize,
     },
-    /// An emotion level is not finite.
-    #[error("emotion level {name:?} is not a finite number")]
+    /// An emotion level is not finite, or a point does not have one level per emotion
+    /// component.
+    #[error("emotion level {name:?} is not finite or does not match the emotion components")]
     NonFiniteLevel {
         /// Name of the level.
         name: String,

@@ -9,11 +9,13 @@
 //! Whole takes are projected and resynthesised in f64 here ([`IcaModel::project`],
 //! [`IcaModel::resynthesize`]); the per-frame f32 path is [`crate::project::Projector`].
 
+mod emotion;
 mod error;
 mod file;
 mod json_rows;
 mod take;
 
+pub use emotion::{BlendError, EmotionLevels, EmotionPoint, SpaceTarget};
 pub use error::ModelError;
 pub use file::FORMAT_VERSION;
 
@@ -22,6 +24,32 @@ use crate::report::TrainReport;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashMap};
+
+/// Checks an emotion space against a model of `m` components: components in range, ascending
+/// and unique; every point finite with one level (and one spread, if any) per component.
+pub(crate) fn check_emotion_space(
+    components: &[usize],
+    points: &BTreeMap<String, EmotionPoint>,
+    m: usize,
+) -> Result<(), ModelError> {
+    for (i, &k) in components.iter().enumerate() {
+        if k >= m || (i > 0 && components[i - 1] >= k) {
+            return Err(ModelError::ComponentOutOfRange {
+                what: "emotion component",
+                index: k,
+                components: m,
+            });
+        }
+    }
+    for (name, p) in points {
+        let spread_ok = p.spread.is_empty() || p.spread.len() == components.len();
+        let finite = p.level.iter().chain(&p.spread).all(|v| v.is_finite());
+        if p.level.len() != components.len() || !spread_ok || !finite {
+            return Err(ModelError::NonFiniteLevel { name: name.clone() });
+        }
+    }
+    Ok(())
+}
 
 /// A mixing matrix whose smallest singular value is at most `RANK_TOL` x its largest is
 /// rejected as rank deficient: beyond a condition number of 1e8 the projection amplifies f64
@@ -50,16 +78,6 @@ pub enum Role {
     Eyelids,
     /// Analysed, none of the above.
     Other,
-}
-
-/// Named values of the emotion component, e.g. `happy → 1.8`, `frustrated → -1.2`: the
-/// extremes the paper's *Translate* edit moves between.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-pub struct EmotionLevels {
-    /// Which component carries emotion, once known.
-    pub component: Option<usize>,
-    /// Level name → value of the emotion component, ordered by name.
-    pub levels: BTreeMap<String, f64>,
 }
 
 /// A validated ICA model. See the module docs.
@@ -292,8 +310,72 @@ impl IcaModel {
         Ok(())
     }
 
+    /// Sets the emotion space: its components (ascending, at least one) and each emotion's
+    /// point over them. The components get [`Role::Emotion`] (components no longer in the space
+    /// go back to [`Role::Unknown`]); the main component (`main`, one of them) and its scalar
+    /// levels are kept for tools that read one component.
+    ///
+    /// # Errors
+    /// [`ModelError::ComponentOutOfRange`] for a component outside the model or a `main` not in
+    /// the space, [`ModelError::NonFiniteLevel`] for a non-finite or misshapen point.
+    pub fn set_emotion_space(
+        &mut self,
+        components: Vec<usize>,
+        main: usize,
+        points: BTreeMap<String, EmotionPoint>,
+        persistence: Vec<f64>,
+    ) -> Result<(), ModelError> {
+        if !(persistence.is_empty() || persistence.len() == components.len())
+            || persistence.iter().any(|v| !v.is_finite())
+        {
+            return Err(ModelError::NonFiniteLevel {
+                name: "persistence".into(),
+            });
+        }
+        check_emotion_space(&components, &points, self.components())?;
+        let main_at =
+            components
+                .iter()
+                .position(|&k| k == main)
+                .ok_or(ModelError::ComponentOutOfRange {
+                    what: "main emotion component",
+                    index: main,
+                    components: self.components(),
+                })?;
+        for (k, role) in self.roles.iter_mut().enumerate() {
+            if *role == Role::Emotion && !components.contains(&k) {
+                *role = Role::Unknown;
+            }
+        }
+        for &k in &components {
+            self.roles[k] = Role::Emotion;
+        }
+        self.emotion = EmotionLevels {
+            component: Some(main),
+            levels: points
+                .iter()
+                .map(|(name, p)| (name.clone(), p.level[main_at]))
+                .collect(),
+            components,
+            points,
+            persistence,
+        };
+        Ok(())
+    }
+
+    /// Forgets the emotion space (components back to [`Role::Unknown`], no points).
+    pub fn clear_emotion_space(&mut self) {
+        for role in &mut self.roles {
+            if *role == Role::Emotion {
+                *role = Role::Unknown;
+            }
+        }
+        self.emotion = EmotionLevels::default();
+    }
+
     /// Removes a named emotion level, returning its value.
     pub fn remove_emotion_level(&mut self, name: &str) -> Option<f64> {
+        self.emotion.points.remove(name);
         self.emotion.levels.remove(name)
     }
 

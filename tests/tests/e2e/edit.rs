@@ -56,14 +56,10 @@ async fn every_frame_comes_out_edited_exactly_as_offline() {
     fixed.set_offset(1, 0.8).expect("in range");
     fixed.set_gain(2, 1.4).expect("in range");
     let level = m.model.emotion().levels["happy"] as f32;
-    let mut emotion = EditState::new(
-        m.model.components(),
-        m.model.emotion().component,
-        DEFAULT_LOWPASS_S,
-    );
+    let mut emotion = EditState::for_model(&m.model, DEFAULT_LOWPASS_S);
     emotion.set_ramp(0.0);
     emotion
-        .set_target("happy", level)
+        .set_target("happy", &[level])
         .expect("emotion component");
     emotion.set_amount(0.7).expect("finite");
     let dt = (1.0 / m.model.rate_hz()) as f32;
@@ -96,4 +92,80 @@ async fn every_frame_comes_out_edited_exactly_as_offline() {
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f32::max);
     assert!(moved > 0.1, "edit moved markers by only {moved} mm");
+}
+
+#[tokio::test]
+async fn an_emotion_space_target_and_mix_come_out_as_offline_and_the_list_names_them() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("space.json");
+    let model = daemon::serve::synthetic::random_space_model(MARKERS, COMPONENTS, 5);
+    write_model(&model, &path);
+    let d = start(&path, vec![]).await;
+    let control = ControlClient::new(d.control).await;
+    match control.send(&Control::EmotionList).await {
+        Reply::EmotionList(list) => {
+            assert_eq!(list.components, vec![0, 2]);
+            let names: Vec<&str> = list.emotions.iter().map(|e| e.0.as_str()).collect();
+            assert_eq!(names, ["angry", "happy", "neutral", "sad"]);
+            assert_eq!(list.emotions[0].1, vec![-1.0, 1.5]);
+        }
+        other => panic!("expected the emotion list, got {other:?}"),
+    }
+    let mix = Control::Mix(vec![("sad".into(), 1.0), ("angry".into(), 1.0)]);
+    for c in [
+        Control::Ramp(0.0),
+        Control::Target("angry".into()),
+        Control::Amount(1.0),
+    ] {
+        assert!(matches!(control.send(&c).await, Reply::Confirm(_)), "{c:?}");
+    }
+    let rx = Receiver::subscribe(&control, Profile::Compact).await;
+    let frames = take_frames(&model, FRAMES);
+    let collect = rx.spawn_frames(Duration::from_millis(300));
+    let mut source = Source::new(d.frames, &model).await;
+    for (n, xyz) in frames.iter().enumerate() {
+        if n == FRAMES / 2 {
+            assert!(matches!(control.send(&mix).await, Reply::Confirm(_)));
+        }
+        source.frame(n as i32, xyz).await;
+        // Let the mix land between the same two frames live and offline.
+        if n + 1 == FRAMES / 2 {
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+    }
+    let got = collect.await.expect("receiver");
+    let unknown = Control::Mix(vec![("bored".into(), 1.0)]);
+    assert!(matches!(control.send(&unknown).await, Reply::Error { .. }));
+    d.stop().await;
+
+    // Offline: `emoshift edit --to-emotion angry --lowpass 1`, then the blend from mid-take.
+    let mut take = replay::Take::new(model.labels().to_vec(), 120.0, 0);
+    for xyz in &frames {
+        take.push_frame(xyz, &[false; MARKERS]);
+    }
+    let map = LabelMap::new(model.labels(), &take.labels).expect("same labels");
+    let projected =
+        offline::project_take(&model, &offline::to_model_order(&take, &map)).expect("project");
+    let mut emotion = EditState::for_model(&model, DEFAULT_LOWPASS_S);
+    emotion.set_ramp(0.0);
+    emotion.set_target("angry", &[-1.0, 1.5]).expect("space");
+    emotion.set_amount(1.0).expect("finite");
+    let dt = (1.0 / model.rate_hz()) as f32;
+    let edited = offline::resynthesise(&model, &projected, |f, u| {
+        if f == FRAMES / 2 {
+            emotion.set_target("sad:0.50,angry:0.50", &[-1.0, 0.0])?;
+        }
+        emotion.apply(dt, u);
+        Ok(())
+    })
+    .expect("resynthesise");
+    assert_eq!(got.len(), FRAMES, "every frame");
+    let mut worst = 0.0f32;
+    for (f, (_, live)) in got.iter().enumerate() {
+        let off = &edited[f * MARKERS * 3..(f + 1) * MARKERS * 3];
+        for (a, b) in live.iter().zip(off) {
+            worst = worst.max((a - b).abs());
+        }
+    }
+    assert!(worst <= 1e-3, "live and offline differ by {worst} mm");
 }

@@ -106,11 +106,7 @@ pub struct Pipeline {
 impl Pipeline {
     /// A pipeline over `model`, with optional named performers.
     pub fn new(model: Arc<IcaModel>, performers: Vec<Performer>, config: PipelineConfig) -> Self {
-        let template = crate::serve::edit_state::EditState::new(
-            model.components(),
-            model.emotion().component,
-            config.lowpass_s,
-        );
+        let template = crate::serve::edit_state::EditState::for_model(&model, config.lowpass_s);
         Pipeline {
             layouts: LayoutBook::new(MAX_SOURCES),
             streams: Streams::new(MAX_SOURCES),
@@ -155,11 +151,8 @@ impl Pipeline {
     /// Swaps in a new default model at a frame boundary: streams on the default model are
     /// rebuilt on it, keeping their edit settings; no frame is dropped.
     pub fn set_model(&mut self, model: Arc<IcaModel>) {
-        let mut template = crate::serve::edit_state::EditState::new(
-            model.components(),
-            model.emotion().component,
-            self.config.lowpass_s,
-        );
+        let mut template =
+            crate::serve::edit_state::EditState::for_model(&model, self.config.lowpass_s);
         template.copy_settings(&self.template);
         self.template = template;
         let old = Arc::clone(&self.model);

@@ -11,6 +11,12 @@
 //!   motion is reconstructed.
 //! - [`label`]: roles from the metrics, with the thresholds in [`LabelRules`].
 
+mod effect;
+
+pub use effect::{
+    emotion_effects, emotion_subspace, f_upper_tail, EmotionEffect, TakeMeans, EMOTION_ALPHA,
+};
+
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
