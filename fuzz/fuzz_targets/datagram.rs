@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use protocol::rosc;
+
 use protocol::{decode_frame_into, messages, Address, FrameBuf, Limits};
 
 fuzz_target!(|data: &[u8]| {

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use protocol::rosc::{self, OscPacket, OscType};
+use rosc::{OscPacket, OscType};
 use protocol::{decode_frame_into, FrameBuf, FrameForm};
 
 fuzz_target!(|data: &[u8]| {

@@ -12,8 +12,8 @@
 use std::net::UdpSocket;
 use std::time::Duration;
 
-use protocol::rosc::OscType;
 use protocol::*;
+use rosc::{OscMessage, OscPacket, OscType};
 
 type Res<T> = Result<T, String>;
 
@@ -232,6 +232,15 @@ fn message_json(m: &Message<'_>, frame: &mut FrameBuf) -> String {
             json_str(&e.to_string()),
             e.kind().as_str()
         ),
+    }
+}
+
+/// A generic message, for printing every argument: the protocol's pre-scan, then rosc.
+fn decode_osc(bytes: &[u8]) -> Result<OscMessage, DecodeError> {
+    check_datagram(bytes, &Limits::default())?;
+    match rosc::decoder::decode_udp(bytes) {
+        Ok((_, OscPacket::Message(m))) => Ok(m),
+        _ => Err(DecodeError::WrongTypeTags),
     }
 }
 

@@ -136,11 +136,11 @@ pub enum ControlError {
 }
 
 /// Decodes one message (not a bundle) with rosc after the crate's own pre-scan: the generic
-/// path for everything that is not a frame.
+/// path for everything that is not a frame. Crate-private: rosc's types stay inside.
 ///
 /// # Errors
 /// Any structural [`DecodeError`]; [`DecodeError::BadAddress`] for a bundle.
-pub fn decode_osc(msg: &[u8]) -> Result<OscMessage, DecodeError> {
+pub(crate) fn decode_osc(msg: &[u8]) -> Result<OscMessage, DecodeError> {
     if msg.first() == Some(&b'#') {
         return Err(DecodeError::BadAddress { offset: 0 });
     }
@@ -361,7 +361,7 @@ impl Control {
     }
 
     /// The arguments in canonical wire types (as sent, and as echoed by the confirm).
-    pub fn args(&self) -> Vec<OscType> {
+    pub(crate) fn args(&self) -> Vec<OscType> {
         use OscType as T;
         match self {
             Control::Target(s) | Control::ModelLoad(s) => vec![T::String(s.clone())],

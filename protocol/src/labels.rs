@@ -62,11 +62,7 @@ pub fn decode_labels(msg: &[u8]) -> Result<Labels, DecodeError> {
 /// [`EncodeError::NulInString`] if a name contains a NUL byte.
 pub fn encode_labels_into(labels: &Labels, out: &mut Vec<u8>) -> Result<usize, EncodeError> {
     out.clear();
-    wire::put_str_unchecked(out, LABELS);
-    out.extend_from_slice(b",i");
-    out.resize(out.len() + labels.names.len(), b's');
-    out.push(0);
-    wire::pad_to4(out, 0);
+    wire::put_prologue(out, 0, LABELS, b"i", b's', labels.names.len());
     wire::put_i32(out, labels.layout_id);
     for name in &labels.names {
         if let Err(e) = wire::put_str(out, name) {

@@ -101,7 +101,7 @@ mod scan;
 mod wire;
 
 pub use address::Address;
-pub use control::{decode_control, decode_osc, Control, ControlError, Profile};
+pub use control::{decode_control, Control, ControlError, Profile};
 pub use error::{DecodeError, DecodeErrorKind, EncodeError};
 pub use frame::{
     all_finite, decode_frame_into, encode_frame_flat_into, encode_frame_into, frame_message_len,
@@ -111,14 +111,13 @@ pub use labels::{
     decode_labels, encode_labels_into, Labels, LayoutBook, LayoutChange, MAX_LAYOUTS_PER_SOURCE,
 };
 pub use output::{
-    decode_components_into, decode_part_into, encode_compact_into, encode_components_into,
-    FlatSplit, PartHeader, ETHERNET_PAYLOAD,
+    decode_blend_val, decode_components_into, decode_part_into, decode_state, encode_compact_into,
+    encode_components_into, FlatSplit, PartHeader, State, ETHERNET_PAYLOAD,
 };
 pub use reply::{
     decode_reply, encode_confirm_into, encode_control_into, encode_emotion_list_into,
     encode_error_into, encode_status_into, EmotionList, Reply,
 };
-pub use rosc;
 pub use scan::{
     check_datagram, messages, Limits, Message, Messages, TimeTag, BUNDLE_DEPTH_CAP,
     DEFAULT_MAX_BUNDLE_DEPTH, MAX_ARRAY_DEPTH, MAX_UDP_PAYLOAD,

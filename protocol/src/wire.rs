@@ -125,6 +125,25 @@ pub(crate) fn put_f32(out: &mut Vec<u8>, v: f32) {
 }
 
 /// Appends a blob header for `len` bytes; the caller appends the bytes, then [`pad_to4`].
+/// Writes a message's address and its type tag string `,` + `fixed` + `count` × `repeated`,
+/// NUL-terminated and padded to 4 bytes from `start` (the message's first byte): the prologue
+/// of every message whose argument list is a fixed head and a run of one type.
+pub(crate) fn put_prologue(
+    out: &mut Vec<u8>,
+    start: usize,
+    address: &str,
+    fixed: &[u8],
+    repeated: u8,
+    count: usize,
+) {
+    put_str_unchecked(out, address);
+    out.push(b',');
+    out.extend_from_slice(fixed);
+    out.resize(out.len() + count, repeated);
+    out.push(0);
+    pad_to4(out, start);
+}
+
 pub(crate) fn put_blob_len(out: &mut Vec<u8>, len: usize) {
     put_u32(
         out,

@@ -2,8 +2,8 @@
 //! on arbitrary or mutated input.
 
 use proptest::prelude::*;
-use protocol::rosc::{self, OscPacket, OscType};
 use protocol::*;
+use rosc::{OscMessage, OscPacket, OscType};
 
 fn frame_strategy() -> impl Strategy<Value = FrameBuf> {
     (0usize..=130, any::<i32>(), any::<i64>())
@@ -201,6 +201,8 @@ proptest! {
         let mut g = FrameBuf::new();
         decode_frame_into(msgs[0].bytes, &mut g).expect("frame");
         prop_assert!(same_positions(g.positions(), f.positions()));
+        let ours = decode_state(msgs[1].bytes).expect("state");
+        prop_assert_eq!((ours.target, ours.amount), (target.as_str(), amount));
         let state = decode_osc(msgs[1].bytes).expect("state");
         prop_assert_eq!(state.addr.as_str(), "/emoshift/state");
         prop_assert_eq!(state.args, vec![OscType::String(target), OscType::Float(amount)]);
@@ -247,6 +249,7 @@ proptest! {
         } else {
             prop_assert_eq!(msgs.len(), kept.len() + 2);
             for ((name, i), m) in kept.iter().zip(&msgs[1..]) {
+                prop_assert_eq!(decode_blend_val(m.bytes), Ok((name.as_str(), u[*i])));
                 let v = decode_osc(m.bytes).expect("val");
                 prop_assert_eq!(v.addr.as_str(), "/VMC/Ext/Blend/Val");
                 prop_assert_eq!(v.args, vec![OscType::String(name.clone()), OscType::Float(u[*i])]);
@@ -279,4 +282,12 @@ fn control_strategy() -> impl Strategy<Value = Control> {
         Just(Control::RecordStop),
         Just(Control::Status),
     ]
+}
+
+/// One message decoded by rosc, the independent reader the properties check against.
+fn decode_osc(bytes: &[u8]) -> Result<OscMessage, String> {
+    match rosc::decoder::decode_udp(bytes) {
+        Ok((_, OscPacket::Message(m))) => Ok(m),
+        other => Err(format!("not one message: {other:?}")),
+    }
 }

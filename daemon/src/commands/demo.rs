@@ -456,13 +456,9 @@ fn receive(socket: &UdpSocket, seen: &Mutex<Vec<(i32, Seen)>>, stop: &AtomicBool
                     }
                 }
                 Some(Address::State) => {
-                    if let Ok(msg) = protocol::decode_osc(m.bytes) {
-                        if let [rosc::OscType::String(t), rosc::OscType::Float(a)] =
-                            msg.args.as_slice()
-                        {
-                            target = t.clone();
-                            amount = *a;
-                        }
+                    if let Ok(state) = protocol::decode_state(m.bytes) {
+                        target = state.target.to_string();
+                        amount = state.amount;
                     }
                 }
                 _ => {}

@@ -72,11 +72,7 @@ pub(crate) fn append_frame(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<(), En
 pub fn encode_frame_flat_into(frame: &FrameBuf, out: &mut Vec<u8>) -> Result<usize, EncodeError> {
     out.clear();
     let h = frame.header;
-    wire::put_str_unchecked(out, FRAME);
-    out.extend_from_slice(b",ih");
-    out.resize(out.len() + frame.positions.len(), b'f');
-    out.push(0);
-    wire::pad_to4(out, 0);
+    wire::put_prologue(out, 0, FRAME, b"ih", b'f', frame.positions.len());
     wire::put_i32(out, h.frame_number);
     wire::put_i64(out, h.capture_time_us);
     for (m, xyz) in frame.positions.chunks_exact(3).enumerate() {

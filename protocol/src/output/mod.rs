@@ -1,10 +1,15 @@
 //! Output profiles: compact, flat-split and components. All encode into a caller `Vec<u8>`
 //! (cleared, capacity reused) without other allocation.
 
+mod decode;
+
+pub use decode::{
+    decode_blend_val, decode_components_into, decode_part_into, decode_state, PartHeader, State,
+};
+
 use crate::address::{COMPONENTS, PART, STATE, VMC_BLEND_APPLY, VMC_BLEND_VAL};
-use crate::error::{DecodeError, EncodeError};
+use crate::error::EncodeError;
 use crate::frame::{append_frame, FrameBuf};
-use crate::scan::read_head;
 use crate::wire::{self, pad4};
 
 /// Payload that fits one Ethernet frame: 1,500 - 20 (IPv4) - 8 (UDP).
@@ -93,11 +98,7 @@ impl FlatSplit {
             return 0;
         }
         let count = self.markers_per_part.min(n - first);
-        wire::put_str_unchecked(out, PART);
-        out.extend_from_slice(b",iiii");
-        out.resize(out.len() + 3 * count, b'f');
-        out.push(0);
-        wire::pad_to4(out, 0);
+        wire::put_prologue(out, 0, PART, b"iiii", b'f', 3 * count);
         let h = frame.header();
         wire::put_i32(out, h.frame_number);
         for v in [first, count, n] {
@@ -111,83 +112,6 @@ impl FlatSplit {
         }
         out.len()
     }
-}
-
-/// Header of a decoded `/mocap/part`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PartHeader {
-    /// Frame number.
-    pub frame_number: i32,
-    /// Index of the first marker in this part.
-    pub first_marker: usize,
-    /// Markers in this part.
-    pub marker_count: usize,
-    /// Markers in the whole frame.
-    pub total_markers: usize,
-}
-
-/// Decodes a `/mocap/part` into `positions[3 * first .. 3 * (first + count)]` (a frame-sized
-/// caller buffer), without allocating. NaN coordinates (missing markers) are kept.
-///
-/// # Errors
-/// [`DecodeError::WrongTypeTags`], [`DecodeError::WrongCount`] (float count vs marker count),
-/// [`DecodeError::OutOfRange`] (negative or inconsistent indices),
-/// [`DecodeError::TooManyMarkers`] (frame larger than `positions`), [`DecodeError::NonFinite`]
-/// (infinite coordinate), truncation and trailing bytes.
-pub fn decode_part_into(msg: &[u8], positions: &mut [f32]) -> Result<PartHeader, DecodeError> {
-    let (address, tags, mut r) = read_head(msg)?;
-    if address != PART {
-        return Err(DecodeError::UnknownAddress);
-    }
-    let Some(floats) = tags
-        .strip_prefix(b"iiii")
-        .filter(|f| f.iter().all(|&t| t == b'f'))
-    else {
-        return Err(DecodeError::WrongTypeTags);
-    };
-    let frame_number = r.i32()?;
-    let mut ints = [0usize; 3];
-    for (k, v) in ints.iter_mut().enumerate() {
-        *v = usize::try_from(r.i32()?).map_err(|_| DecodeError::OutOfRange { index: k + 1 })?;
-    }
-    let [first, count, total] = ints;
-    if floats.len() != 3 * count {
-        return Err(DecodeError::WrongCount {
-            expected: 3 * count,
-            got: floats.len(),
-        });
-    }
-    if first + count > total {
-        return Err(DecodeError::OutOfRange { index: 2 });
-    }
-    if 3 * total > positions.len() {
-        return Err(DecodeError::TooManyMarkers {
-            markers: total,
-            max: positions.len() / 3,
-        });
-    }
-    let coords = r.take(12 * count)?;
-    if r.remaining() != 0 {
-        return Err(DecodeError::TrailingBytes {
-            offset: r.pos(),
-            extra: r.remaining(),
-        });
-    }
-    let dst = &mut positions[3 * first..3 * (first + count)];
-    for (i, (c, d)) in coords.chunks_exact(4).zip(dst.iter_mut()).enumerate() {
-        *d = f32::from_be_bytes([c[0], c[1], c[2], c[3]]);
-        if d.is_infinite() {
-            return Err(DecodeError::NonFinite {
-                marker: first + i / 3,
-            });
-        }
-    }
-    Ok(PartHeader {
-        frame_number,
-        first_marker: first,
-        marker_count: count,
-        total_markers: total,
-    })
 }
 
 /// Encodes the components profile into `out` (cleared first). Returns the encoded length.
@@ -234,44 +158,8 @@ pub fn encode_components_into<S: AsRef<str>>(
 
 fn append_components(u: &[f32], out: &mut Vec<u8>) {
     let start = out.len();
-    wire::put_str_unchecked(out, COMPONENTS);
-    out.push(b',');
-    out.resize(out.len() + u.len(), b'f');
-    out.push(0);
-    wire::pad_to4(out, start);
+    wire::put_prologue(out, start, COMPONENTS, b"", b'f', u.len());
     for &v in u {
         wire::put_f32(out, v);
     }
-}
-
-/// Decodes `/emoshift/components ,f...` into `u` without allocating; returns how many values.
-///
-/// # Errors
-/// [`DecodeError::WrongTypeTags`], [`DecodeError::TooManyMarkers`] (more values than `u`
-/// holds), truncation and trailing bytes.
-pub fn decode_components_into(msg: &[u8], u: &mut [f32]) -> Result<usize, DecodeError> {
-    let (address, tags, mut r) = read_head(msg)?;
-    if address != COMPONENTS {
-        return Err(DecodeError::UnknownAddress);
-    }
-    if !tags.iter().all(|&t| t == b'f') {
-        return Err(DecodeError::WrongTypeTags);
-    }
-    let n = tags.len();
-    if n > u.len() {
-        return Err(DecodeError::TooManyMarkers {
-            markers: n,
-            max: u.len(),
-        });
-    }
-    for v in &mut u[..n] {
-        *v = r.f32()?;
-    }
-    if r.remaining() != 0 {
-        return Err(DecodeError::TrailingBytes {
-            offset: r.pos(),
-            extra: r.remaining(),
-        });
-    }
-    Ok(n)
 }
