@@ -18,7 +18,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::fit::{FitData, FitError};
+use crate::input::{FitData, FitError};
 use crate::whiten::{self, Components};
 
 /// Rounds of PCA and filling.

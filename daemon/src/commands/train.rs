@@ -4,8 +4,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use ica_core::fit::{Components, FastIcaParams, FitData};
+use ica_core::measure::{noise_per_coordinate, TrainingFrames};
 use ica_core::model::IcaModel;
-use ica_core::quality::measure::{noise_per_coordinate, TrainingFrames};
 use ica_core::whiten::DEFAULT_VARIANCE_TARGET;
 use indicatif::{ProgressBar, ProgressStyle};
 

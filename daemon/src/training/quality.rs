@@ -3,10 +3,10 @@
 
 use std::collections::BTreeMap;
 
-use ica_core::model::IcaModel;
-use ica_core::quality::measure::{
+use ica_core::measure::{
     noise_per_coordinate, one_marker_components, residual_by_marker, slow_residual, TrainingFrames,
 };
+use ica_core::model::IcaModel;
 use ica_core::quality::{ModelQuality, WarningKind};
 use ica_core::stabilise::search::FACE_LEAKAGE;
 use replay::session::Regions;

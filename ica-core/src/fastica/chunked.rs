@@ -7,9 +7,9 @@
 
 use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
 
-use super::gemm::{mul_add, strided};
 use super::Contrast;
-use crate::fit::FitError;
+use crate::input::FitError;
+use crate::linalg::{mul_add, strided};
 
 /// Frames per block: the block and its sources (2 x 1024 x m f64) stay in L2 at m = 20.
 pub(crate) const BLOCK_FRAMES: usize = 1024;

@@ -14,14 +14,12 @@
 mod chunked;
 mod contrast;
 mod deflation;
-mod gemm;
 mod refine;
 mod subsample;
 mod symmetric;
 
 pub use chunked::{SourceMoments, Update, UpdateAccumulator};
 pub use contrast::Contrast;
-pub(crate) use gemm::{mul_add, strided};
 pub use refine::{refine_chunked, ChunkSink, RefineOutcome, RefineSettings, Refiner};
 pub use subsample::{Subsample, SubsamplePlan};
 

@@ -13,7 +13,7 @@ use super::chunked::UpdateAccumulator;
 use super::deflation::orthonormalise;
 use super::symmetric::{decorrelate, StepControl};
 use super::{Algorithm, Contrast};
-use crate::fit::FitError;
+use crate::input::FitError;
 
 /// What the iteration runs: update rule, contrast, stopping rule.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -233,7 +233,8 @@ pub fn refine_chunked<T: Copy + Into<f64>>(
 mod tests {
     use super::*;
     use crate::fastica::{deflation, random_start, symmetric};
-    use crate::fit::{mixture, FitData};
+    use crate::input::FitData;
+    use crate::mixture;
     use crate::whiten::{whiten, Components};
 
     /// Whitened face-like frames, `m x frames`.

@@ -8,7 +8,7 @@
 use nalgebra::DMatrix;
 
 use super::EXPLORE_FRAMES;
-use crate::fit::FitError;
+use crate::input::FitError;
 
 /// Which frames the whitening pass keeps for the restarts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

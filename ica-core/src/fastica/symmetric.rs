@@ -7,8 +7,8 @@
 
 use nalgebra::{DMatrix, SymmetricEigen};
 
-use super::gemm::{mul_add, strided, StridedView};
 use super::{Contrast, Outcome};
+use crate::linalg::{mul_add, strided, StridedView};
 
 /// Buffers reused by every iteration of one fit.
 #[derive(Debug)]

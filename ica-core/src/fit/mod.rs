@@ -44,19 +44,17 @@
 
 mod amari;
 mod assemble;
-mod data;
-mod error;
-pub mod mixture;
 mod params;
 mod source;
 mod stream;
 
+pub use crate::input::Pass;
+pub use crate::input::{FitData, FitError};
+pub use crate::mixture;
 pub use amari::amari_index;
-pub use data::FitData;
-pub use error::FitError;
 pub use params::{FastIcaParams, DEFAULT_MAX_ITER, DEFAULT_RESTARTS, DEFAULT_SEED, DEFAULT_TOL};
 pub use source::{ChunkSource, MemorySource, MemoryStore, StreamError, WhitenedStore};
-pub use stream::{Pass, StreamFit};
+pub use stream::StreamFit;
 
 pub use crate::fastica::{Algorithm, Contrast};
 pub use crate::whiten::Components;

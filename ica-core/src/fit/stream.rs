@@ -16,43 +16,15 @@
 //! A short take (under twice [`crate::fastica::EXPLORE_FRAMES`] used frames) is done after the
 //! whitening pass: its whitened frames are all in the subsample and it is fitted in memory.
 
-use std::fmt;
-
 use super::assemble::{self, Solved};
 use super::{FastIcaParams, FitError, FitOutput};
 use crate::fastica::{
     self, restart_seed, RefineOutcome, RefineSettings, Refiner, SourceMoments, Subsample,
     SubsamplePlan, UpdateAccumulator,
 };
+use crate::input::Pass;
 use crate::whiten::{Moments, Whitener};
 use crate::{Refinement, RestartReport};
-
-/// The pass a streaming fit needs next.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Pass {
-    /// Raw frames into [`Moments`].
-    Moments,
-    /// Raw frames whitened, kept for the later passes and subsampled for the restarts.
-    Whiten,
-    /// Whitened frames into an [`UpdateAccumulator`]: one FastICA iteration.
-    Update,
-    /// Whitened frames into [`SourceMoments`]: negentropy and skewness of the result.
-    Sources,
-    /// Nothing left to read: [`StreamFit::finish`].
-    Done,
-}
-
-impl fmt::Display for Pass {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Pass::Moments => "statistics",
-            Pass::Whiten => "whitening",
-            Pass::Update => "update",
-            Pass::Sources => "sources",
-            Pass::Done => "final",
-        })
-    }
-}
 
 /// A fit over data read in passes (see the module docs for the call order).
 #[derive(Debug)]

@@ -26,33 +26,12 @@ mod masked;
 
 pub use masked::MIN_OBSERVABILITY;
 
-use crate::edit::FrameEdit;
+pub use crate::frame::FrameError;
+
+use crate::frame::FrameEdit;
 use crate::model::IcaModel;
 use kernels::{axpy, axpy4, axpy4_onto, panel_gemv, sub_into, PANEL_WIDTHS};
 use masked::MaskedSolver;
-
-/// A frame buffer of the wrong length. Small and `Copy`: returned per frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-pub enum FrameError {
-    /// A slice's length does not match the model.
-    #[error("{what} has {got} values, the model needs {expected}")]
-    Length {
-        /// Which argument (`frame`, `components`, `output`, `missing mask`, `edit`).
-        what: &'static str,
-        /// Length the model needs.
-        expected: usize,
-        /// Length given.
-        got: usize,
-    },
-    /// A component index is outside the model.
-    #[error("component {index} is out of range: the model has {components} components")]
-    ComponentOutOfRange {
-        /// The index.
-        index: usize,
-        /// Components in the model.
-        components: usize,
-    },
-}
 
 /// What happened to one frame's projection.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

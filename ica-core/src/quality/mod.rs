@@ -3,8 +3,6 @@
 //! read. Stored in the model file (optional: older files load without it), printed by `train`,
 //! shown by `inspect` and `analyze`.
 
-pub mod measure;
-
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};

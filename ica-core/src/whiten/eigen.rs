@@ -14,7 +14,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::fastica::{mul_add, strided};
+use crate::linalg::{mul_add, strided};
 
 /// A Ritz vector is accepted when `|C v - theta v| <= RESIDUAL * lambda_1`: its angle to the
 /// true eigenvector is then below `RESIDUAL * lambda_1 / gap`, far below sampling noise.

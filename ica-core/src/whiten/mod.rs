@@ -26,7 +26,7 @@ use pca::Stats;
 
 use nalgebra::DMatrix;
 
-use crate::fit::{FitData, FitError};
+use crate::input::{FitData, FitError};
 
 /// Smallest accepted variance target.
 pub const MIN_VARIANCE_TARGET: f64 = 0.90;

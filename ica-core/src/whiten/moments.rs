@@ -23,7 +23,7 @@ use nalgebra::{DMatrix, DMatrixView};
 
 use super::pca::frame_is_used;
 use super::syrk::{accumulate_upper, rank_one_upper};
-use crate::fit::{FitData, FitError};
+use crate::input::{FitData, FitError};
 
 /// Used frames centred per syrk call: 128 x 327 f64 (335 KB) stays in L2 (see benches/stream.rs).
 const BLOCK_FRAMES: usize = 128;

@@ -5,7 +5,7 @@
 use nalgebra::DMatrix;
 
 use super::{eigen, Components, Moments, DEAD_CHANNEL_RELATIVE_VARIANCE, RANK_RELATIVE_EIGENVALUE};
-use crate::fit::FitError;
+use crate::input::FitError;
 
 /// PCA whitening fitted to the used frames, without the data: `z = Λ^{-1/2} Eᵀ (x - mean)` on
 /// the live channels.
@@ -264,7 +264,8 @@ fn choose_m(
 
 #[cfg(test)]
 mod tests {
-    use crate::fit::{mixture, FitData};
+    use crate::input::FitData;
+    use crate::mixture;
     use crate::whiten::{whiten, Components};
 
     /// Issue 18: the PCA axes' signs follow the data, not the eigen-solver's rounding.

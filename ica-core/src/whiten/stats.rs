@@ -4,9 +4,9 @@
 use nalgebra::{DMatrix, DMatrixView};
 
 use super::syrk::{accumulate_upper, mirror_upper};
-use crate::fastica::mul_add;
+use crate::linalg::mul_add;
 
-use crate::fit::{FitData, FitError};
+use crate::input::{FitData, FitError};
 
 /// Frames gathered per gemm call: large enough to amortise packing, small enough to stay in cache.
 const CHUNK_FRAMES: usize = 256;

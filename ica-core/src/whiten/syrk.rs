@@ -6,7 +6,7 @@
 
 use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
 
-use crate::fastica::{mul_add, strided};
+use crate::linalg::{mul_add, strided};
 
 /// `cov[I, J] += x[I, :] x[J, :]^T` for channel blocks `I <= J` of edge `block`.
 ///

@@ -5,8 +5,8 @@ use nalgebra::DMatrixView;
 
 use super::pca::frame_is_used;
 use super::Whitener;
-use crate::fastica::mul_add;
-use crate::fit::{FitData, FitError};
+use crate::input::{FitData, FitError};
+use crate::linalg::mul_add;
 
 /// Used frames centred per gemm call.
 const BLOCK_FRAMES: usize = 256;

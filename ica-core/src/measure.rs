@@ -1,4 +1,5 @@
-//! The numbers behind a model's quality report, measured on its training frames.
+//! The numbers behind a model's quality report ([`crate::quality`]), measured on its
+//! training frames.
 
 use std::ops::Range;
 
