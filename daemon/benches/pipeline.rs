@@ -8,8 +8,8 @@ use std::net::SocketAddr;
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use daemon::serve::pipeline::{Pipeline, PipelineConfig};
-use daemon::serve::synthetic::{frame_into, labels_datagram, random_model};
+use daemon::engine::pipeline::{Pipeline, PipelineConfig};
+use daemon::loopback::synthetic::{frame_into, labels_datagram, random_model};
 use ica_core::model::{CaptureSettings, IcaModel, MarkerBounds};
 use protocol::{encode_frame_into, FrameBuf};
 

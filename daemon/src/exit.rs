@@ -35,22 +35,3 @@ pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
             .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
     })
 }
-
-/// The whole `emoshift` program after argument parsing: install logging, run the command, print
-/// an error as one line and map it to an exit code. Shared by the `emoshift` binary and the
-/// copy the end-to-end tests build, so both behave the same.
-pub fn main_with(cli: crate::cli::Cli) -> std::process::ExitCode {
-    let default_level = match cli.command {
-        crate::cli::Command::Demo(_) => "warn",
-        _ => "info",
-    };
-    crate::logging::install(default_level);
-    match crate::commands::run(cli) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(err) if is_broken_pipe(&err) => std::process::ExitCode::SUCCESS,
-        Err(err) => {
-            eprintln!("emoshift: error: {err:#}");
-            std::process::ExitCode::from(code_for(&err))
-        }
-    }
-}

@@ -6,16 +6,14 @@
 //! crates (`replay`, `ica-core`, `protocol`).
 #![warn(missing_docs)]
 
-pub mod analysis;
 pub mod cli;
 pub mod commands;
+pub mod engine;
 pub mod exit;
-pub mod frame;
-pub mod layout;
 pub mod logging;
+pub mod loopback;
 pub mod offline;
 pub mod serve;
-pub mod training;
 
 /// `println!` that returns the I/O error instead of panicking, so `emoshift info x | head` ends
 /// quietly when the reader goes away (see [`exit::code_for`], which treats a broken pipe as

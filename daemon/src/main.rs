@@ -1,10 +1,10 @@
 //! The `emoshift` binary: parses the command line and hands over to
-//! [`daemon::exit::main_with`].
+//! [`daemon::commands::main_with`].
 
 use std::process::ExitCode;
 
 use clap::Parser;
 
 fn main() -> ExitCode {
-    daemon::exit::main_with(daemon::cli::Cli::parse())
+    daemon::commands::main_with(daemon::cli::Cli::parse())
 }

@@ -6,8 +6,8 @@
 use std::net::SocketAddr;
 use std::sync::Arc;
 
-use daemon::serve::pipeline::{profile_bit, Pipeline, PipelineConfig};
-use daemon::serve::synthetic::{frame_into, random_model};
+use daemon::engine::pipeline::{profile_bit, Pipeline, PipelineConfig};
+use daemon::loopback::synthetic::{frame_into, random_model};
 use protocol::{encode_frame_into, encode_labels_into, Control, FrameBuf, Labels, Profile};
 
 const MARKERS: usize = 109;

@@ -4,8 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
+use daemon::offline::training::{self, HeadChoice, PrepOptions, SpeedLimit};
 use daemon::offline::{self, LoadedTake};
-use daemon::training::{self, HeadChoice, PrepOptions, SpeedLimit};
 use ica_core::model::IcaModel;
 
 mod common;

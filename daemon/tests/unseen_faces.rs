@@ -5,8 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
+use daemon::offline::training::{self, HeadChoice, PrepOptions, SpeedLimit};
 use daemon::offline::{self, LoadedTake};
-use daemon::training::{self, HeadChoice, PrepOptions, SpeedLimit};
 use ica_core::model::IcaModel;
 use ica_core::quality::WarningKind;
 use ica_core::stabilise::{to_world_into, Stabiliser};

@@ -16,6 +16,7 @@ pub mod model;
 pub mod project;
 pub mod quality;
 pub mod report;
+mod robust;
 pub mod stabilise;
 pub mod whiten;
 

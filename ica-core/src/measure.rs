@@ -6,7 +6,7 @@ use std::ops::Range;
 use nalgebra::{DMatrix, DVector};
 
 use crate::model::IcaModel;
-use crate::stabilise::search::{mad, median};
+use crate::robust::{mad, median};
 
 /// Training frames as the model saw them: positions (frames x channels, head coordinates
 /// when stabilised), missing flags per channel, and each take's frame range.

@@ -3,12 +3,12 @@
 
 use anyhow::{Context, Result};
 
-use crate::analysis::{self, Inputs};
 use crate::cli::AnalyzeArgs;
 use crate::offline;
+use crate::offline::analysis::{self, Inputs};
 
 pub(crate) fn run(args: &AnalyzeArgs) -> Result<()> {
-    let mut model = super::load_model(&args.model)?;
+    let mut model = crate::offline::load_model(&args.model)?;
     let session = offline::load_session(&args.manifest)?;
     let regions_path = match &args.regions {
         Some(p) => p.clone(),

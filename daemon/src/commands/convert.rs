@@ -5,7 +5,7 @@ use anyhow::{Context, Result};
 use crate::cli::ConvertArgs;
 
 pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
-    let take = super::load_take(&args.input)?;
+    let take = crate::offline::load_take(&args.input)?;
     replay::save(&args.output, &take).with_context(|| format!("{}", args.output.display()))?;
     let gaps: usize = take.missing.iter().filter(|&&m| m).count();
     crate::out!(

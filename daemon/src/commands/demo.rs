@@ -116,7 +116,7 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
         max_missing: 0.5,
         max_speed: "auto".into(),
         head_reference: None,
-        head_patterns: crate::training::DEFAULT_HEAD_PATTERNS
+        head_patterns: crate::offline::training::DEFAULT_HEAD_PATTERNS
             .iter()
             .map(|p| p.to_string())
             .collect(),
@@ -132,8 +132,8 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
         out: report.clone(),
         write_model: true,
     })?;
-    let model = super::load_model(&model_path)?;
-    let take = super::load_take(&session.take)?;
+    let model = crate::offline::load_model(&model_path)?;
+    let take = crate::offline::load_take(&session.take)?;
     step(4, "serving on loopback and replaying a take through it")?;
     let live = stream(&model_path, &model, &take, session.sweep.as_ref())?;
     step(5, "summary")?;
@@ -278,7 +278,7 @@ fn stream(
     let mut states = Vec::new();
     let start = sent.first_send;
     // The emotion components of what the client received, to show the sweep in model units.
-    let mut processor = crate::frame::FrameProcessor::new(model);
+    let mut processor = crate::engine::frame::FrameProcessor::new(model);
     let mut u = vec![0.0f32; model.components()];
     let space = model.emotion().space_components();
     for (number, s) in seen.iter() {

@@ -22,9 +22,9 @@ use ica_core::project::Projector;
 use replay::Take;
 
 use crate::cli::{EditArgs, KeyValue};
+use crate::engine::edit_state::EditState;
 use crate::exit::UsageError;
 use crate::offline::{self, ModelFrames, Projected};
-use crate::serve::edit_state::EditState;
 
 fn check_component(model: &IcaModel, kv: &KeyValue, flag: &str) -> Result<usize> {
     if kv.key >= model.components() {
@@ -106,7 +106,8 @@ fn aligned_components(this: &Projected, other: &Projected, ks: &[usize]) -> Resu
     };
     let dim = if rest == 0 { m } else { dim };
     let n = a.len() / dim;
-    let band = (n.max(b.len() / dim) as f64 * crate::analysis::DTW_BAND_SHARE).ceil() as usize;
+    let band =
+        (n.max(b.len() / dim) as f64 * crate::offline::analysis::DTW_BAND_SHARE).ceil() as usize;
     let demean = |s: &[f64]| -> Vec<f64> {
         let frames = (s.len() / dim).max(1) as f64;
         let mut mean = vec![0.0; dim];
@@ -228,7 +229,7 @@ fn plan(
         let Some(path) = &args.other_model else {
             return Err(UsageError("--add-emotion-from needs --other-model m2.json".into()).into());
         };
-        let model2 = super::load_model(path)?;
+        let model2 = crate::offline::load_model(path)?;
         if model2.labels() != model.labels() {
             bail!(
                 "{}: Copy & Add needs both models to have the same markers in the same order",
@@ -245,7 +246,7 @@ fn plan(
 }
 
 pub(crate) fn run(args: &EditArgs) -> Result<()> {
-    let model = super::load_model(&args.model)?;
+    let model = crate::offline::load_model(&args.model)?;
     let take = offline::load_take(&args.file)?;
     let map = offline::match_take(&model, &take, &args.file)?;
     let frames = offline::to_model_order(&take, &map);
@@ -288,7 +289,7 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
 fn assemble(
     take: &Take,
     model_labels: &[String],
-    map: &crate::layout::LabelMap,
+    map: &crate::engine::layout::LabelMap,
     frames: &ModelFrames,
     edited: Vec<f32>,
     keep_gaps: bool,

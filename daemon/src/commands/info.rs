@@ -26,7 +26,7 @@ struct MarkerInfo<'a> {
 }
 
 pub(crate) fn run(args: &InfoArgs) -> Result<()> {
-    let take = super::load_take(&args.file)?;
+    let take = crate::offline::load_take(&args.file)?;
     let per_marker = take.missing_per_marker();
     let frames = take.n_frames();
     let info = Info {

@@ -6,7 +6,7 @@ use ica_core::quality::ModelQuality;
 use crate::cli::InspectArgs;
 
 pub(crate) fn run(args: &InspectArgs) -> Result<()> {
-    let model = super::load_model(&args.model)?;
+    let model = crate::offline::load_model(&args.model)?;
     if args.json {
         model.save(std::io::stdout().lock())?;
         crate::out!();

@@ -16,6 +16,26 @@ mod train;
 use anyhow::Result;
 
 use crate::cli::{Cli, Command};
+use crate::exit::{code_for, is_broken_pipe};
+
+/// The whole `emoshift` program after argument parsing: install logging, run the command, print
+/// an error as one line and map it to an exit code ([`crate::exit`]). Shared by the `emoshift`
+/// binary and the copy the end-to-end tests build, so both behave the same.
+pub fn main_with(cli: Cli) -> std::process::ExitCode {
+    let default_level = match cli.command {
+        Command::Demo(_) => "warn",
+        _ => "info",
+    };
+    crate::logging::install(default_level);
+    match run(cli) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(err) if is_broken_pipe(&err) => std::process::ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("emoshift: error: {err:#}");
+            std::process::ExitCode::from(code_for(&err))
+        }
+    }
+}
 
 /// Runs the parsed command line.
 ///
@@ -36,17 +56,4 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Replay(args) => replay::run(&args),
         Command::Demo(args) => demo::run(&args),
     }
-}
-
-/// Loads a take, naming the file in the error.
-pub(crate) fn load_take(path: &std::path::Path) -> Result<::replay::Take> {
-    crate::offline::load_take(path)
-}
-
-/// Loads and validates a model file, naming the file in the error.
-pub(crate) fn load_model(path: &std::path::Path) -> Result<ica_core::model::IcaModel> {
-    use anyhow::Context;
-    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
-    ica_core::model::IcaModel::load(std::io::BufReader::new(file))
-        .with_context(|| format!("{}: not a valid model", path.display()))
 }

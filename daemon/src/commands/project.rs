@@ -8,7 +8,7 @@ use crate::cli::ProjectArgs;
 use crate::offline;
 
 pub(crate) fn run(args: &ProjectArgs) -> Result<()> {
-    let model = super::load_model(&args.model)?;
+    let model = crate::offline::load_model(&args.model)?;
     let take = offline::load_take(&args.file)?;
     let map = offline::match_take(&model, &take, &args.file)?;
     let frames = offline::to_model_order(&take, &map);

@@ -33,7 +33,7 @@ const SPIN: Duration = Duration::from_micros(200);
 const MAX_NAP: Duration = Duration::from_millis(50);
 
 pub(crate) fn run(args: &ReplayArgs) -> Result<()> {
-    let take = super::load_take(&args.file)?;
+    let take = crate::offline::load_take(&args.file)?;
     let to = resolve(&args.to)?;
     if take.n_markers() > protocol::MAX_FRAME_MARKERS {
         anyhow::bail!(

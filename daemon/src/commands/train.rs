@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::cli::TrainArgs;
 use crate::exit::UsageError;
 use crate::offline;
-use crate::training::{self, HeadChoice, PrepOptions, PreparedData, SpeedLimit};
+use crate::offline::training::{self, HeadChoice, PrepOptions, PreparedData, SpeedLimit};
 use replay::session::Regions;
 
 /// The regions file's region naming the rigid head markers.

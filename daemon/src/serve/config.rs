@@ -174,7 +174,7 @@ impl RawConfig {
         };
         let lowpass_s = self
             .lowpass_s
-            .unwrap_or(super::edit_state::DEFAULT_LOWPASS_S);
+            .unwrap_or(crate::engine::edit_state::DEFAULT_LOWPASS_S);
         range(
             "lowpass_s",
             lowpass_s.is_finite() && lowpass_s >= 0.0,
@@ -237,10 +237,10 @@ impl RawConfig {
             send,
             max_subscribers: self
                 .max_subscribers
-                .unwrap_or(super::clients::DEFAULT_MAX_DYNAMIC),
+                .unwrap_or(crate::engine::clients::DEFAULT_MAX_DYNAMIC),
             max_send_failures: self
                 .max_send_failures
-                .unwrap_or(super::clients::DEFAULT_MAX_FAILURES),
+                .unwrap_or(crate::engine::clients::DEFAULT_MAX_FAILURES),
             lowpass_s,
             queue,
             poll_window: Duration::from_micros(poll_window_us),

@@ -19,32 +19,17 @@ use tokio::sync::oneshot;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
-use super::server::Answer;
+use super::command::{Command, Refusal, Reply, Request};
 use super::stats::Stats;
 
 /// How long a control message waits for the processing thread's answer.
 const ANSWER_TIMEOUT: Duration = Duration::from_secs(2);
 
-/// A command for the processing thread, applied between frames.
-#[derive(Debug)]
-pub(crate) enum Cmd {
-    /// An edit setting.
-    Edit(Control, Answer),
-    /// `/subscribe` or `/unsubscribe` from a peer.
-    Client(SocketAddr, Control, Answer),
-    /// Swap in a validated model.
-    SetModel(Arc<IcaModel>, Answer),
-    /// Start recording to a path, and the raw input to another.
-    RecordStart(PathBuf, Option<PathBuf>, Answer),
-    /// Stop recording.
-    RecordStop(Answer),
-}
-
 /// What the control task needs.
 #[derive(Debug, Clone)]
 pub(crate) struct ControlCtx {
     pub(crate) socket: Arc<UdpSocket>,
-    pub(crate) cmd_tx: Sender<Cmd>,
+    pub(crate) cmd_tx: Sender<Request>,
     pub(crate) stats: Arc<Mutex<Stats>>,
     pub(crate) model_path: Arc<Mutex<PathBuf>>,
     /// The default model now (for `/emotion/list`).
@@ -71,7 +56,7 @@ pub(crate) async fn run(ctx: ControlCtx, shutdown: CancellationToken) {
             Err(e) => {
                 tracing::debug!(%peer, error = %e, "refused control message");
                 let address = refused_address(&buf[..len]);
-                reply(&ctx, peer, &address, Err(e.to_string())).await;
+                reply(&ctx, peer, &address, Err(Refusal::Invalid(e.to_string()))).await;
                 continue;
             }
         };
@@ -132,20 +117,42 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
                 encode_emotion_list_into(&list, &mut out);
                 send(ctx, peer, &out).await;
             }
-            None => reply(ctx, peer, address, Err("model unavailable".into())).await,
+            None => {
+                reply(
+                    ctx,
+                    peer,
+                    address,
+                    Err(Refusal::Model("model unavailable".into())),
+                )
+                .await
+            }
         }
         return;
     }
     let result = match &control {
         Control::Subscribe { .. } | Control::Unsubscribe { .. } => {
-            ask(ctx, |tx| Cmd::Client(peer, control.clone(), tx)).await
+            ask(
+                ctx,
+                Command::Client {
+                    peer,
+                    control: control.clone(),
+                },
+            )
+            .await
         }
         Control::RecordStart { path, raw } => {
             let raw = raw.as_ref().map(PathBuf::from);
-            ask(ctx, |tx| Cmd::RecordStart(PathBuf::from(path), raw, tx)).await
+            ask(
+                ctx,
+                Command::RecordStart {
+                    path: PathBuf::from(path),
+                    raw,
+                },
+            )
+            .await
         }
-        Control::RecordStop => ask(ctx, Cmd::RecordStop).await,
-        other => ask(ctx, |tx| Cmd::Edit(other.clone(), tx)).await,
+        Control::RecordStop => ask(ctx, Command::RecordStop).await,
+        other => ask(ctx, Command::Edit(other.clone())).await,
     };
     match result {
         Ok(()) => confirm(ctx, peer, &control).await,
@@ -154,30 +161,26 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
 }
 
 /// Sends a command to the processing thread and waits for its answer.
-async fn ask(ctx: &ControlCtx, make: impl FnOnce(Answer) -> Cmd) -> Result<(), String> {
-    let (tx, rx) = oneshot::channel();
+async fn ask(ctx: &ControlCtx, command: Command) -> Reply {
+    let (reply, rx) = oneshot::channel();
     ctx.cmd_tx
-        .try_send(make(tx))
-        .map_err(|_| "the processing thread is busy or stopped".to_string())?;
-    wait(rx).await
-}
-
-async fn wait(rx: oneshot::Receiver<Result<(), String>>) -> Result<(), String> {
+        .try_send(Request { command, reply })
+        .map_err(|_| Refusal::Busy)?;
     match tokio::time::timeout(ANSWER_TIMEOUT, rx).await {
         Ok(Ok(r)) => r,
-        Ok(Err(_)) => Err("shutting down".to_string()),
-        Err(_) => Err("no answer from the processing thread".to_string()),
+        Ok(Err(_)) => Err(Refusal::ShuttingDown),
+        Err(_) => Err(Refusal::Timeout),
     }
 }
 
 /// Loads and validates a model on a blocking thread, then swaps it in at a frame boundary. A
 /// bad file leaves the old model running.
-async fn reload(ctx: &ControlCtx, path: PathBuf) -> Result<(), String> {
-    let model = super::server::load_model(path.clone())
+async fn reload(ctx: &ControlCtx, path: PathBuf) -> Reply {
+    let model = super::load_model(path.clone())
         .await
-        .map_err(|e| format!("{e:#}"))?;
+        .map_err(|e| Refusal::Model(format!("{e:#}")))?;
     let model = Arc::new(model);
-    ask(ctx, |tx| Cmd::SetModel(Arc::clone(&model), tx)).await?;
+    ask(ctx, Command::SetModel(Arc::clone(&model))).await?;
     if let Ok(mut p) = ctx.model_path.lock() {
         *p = path.clone();
     }
@@ -195,11 +198,11 @@ async fn confirm(ctx: &ControlCtx, peer: SocketAddr, control: &Control) {
 }
 
 /// Sends the error reply of a refused message (`Ok` sends nothing).
-async fn reply(ctx: &ControlCtx, peer: SocketAddr, address: &str, r: Result<(), String>) {
+async fn reply(ctx: &ControlCtx, peer: SocketAddr, address: &str, r: Reply) {
     let Err(e) = r else { return };
     tracing::debug!(%peer, address, error = %e, "control refused");
     let mut out = Vec::with_capacity(256);
-    encode_error_into(address, &e, &mut out);
+    encode_error_into(address, &e.to_string(), &mut out);
     send(ctx, peer, &out).await;
 }
 

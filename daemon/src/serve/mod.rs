@@ -18,23 +18,21 @@
 //! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).
 
 pub mod arrival;
-pub mod clients;
+mod command;
 pub mod config;
 mod control;
-pub mod edit_state;
 pub mod net;
-pub mod pipeline;
 mod processing;
 pub mod record;
 mod sender;
 mod server;
 pub mod stats;
-pub mod streams;
-pub mod synthetic;
 
 pub use config::Config;
-pub use server::{bind, bind_with, load_model, Bound};
+pub use server::{bind, bind_with, Bound};
 
+use anyhow::Context as _;
+use ica_core::model::IcaModel;
 use tokio_util::sync::CancellationToken;
 
 /// Binds, loads the models and serves until `shutdown` is cancelled; then stops receiving,
@@ -44,4 +42,14 @@ use tokio_util::sync::CancellationToken;
 /// A socket that cannot be bound, a model that cannot be loaded, a task that failed.
 pub async fn run(config: Config, shutdown: CancellationToken) -> anyhow::Result<()> {
     bind(config).await?.run(shutdown).await
+}
+
+/// Loads a model file on a blocking thread.
+///
+/// # Errors
+/// Unreadable or invalid file, named.
+pub async fn load_model(path: std::path::PathBuf) -> anyhow::Result<IcaModel> {
+    tokio::task::spawn_blocking(move || crate::offline::load_model(&path))
+        .await
+        .context("model loader panicked")?
 }

@@ -11,12 +11,11 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender};
 
 use super::arrival::{ArrivalClock, SpinWindow, Wait};
-use super::control::Cmd;
-use super::pipeline::{Emitted, Pipeline};
+use super::command::{Command, Refusal, Reply, Request};
 use super::record::Recording;
 use super::sender::Fanout;
-use super::server::Answer;
 use super::stats::Stats;
+use crate::engine::pipeline::{Emitted, Pipeline};
 
 /// The processing thread merges its counters and histograms into the shared [`Stats`] (a
 /// lock, a histogram add and reset: tens of µs) only between bursts, at most this often: with
@@ -45,7 +44,7 @@ pub(crate) struct Channels {
     /// Datagram buffers handed back to the receive task.
     pub(crate) free: Sender<Vec<u8>>,
     /// Control commands, applied between frames.
-    pub(crate) commands: Receiver<Cmd>,
+    pub(crate) commands: Receiver<Request>,
 }
 
 /// The processing thread's state.
@@ -57,7 +56,7 @@ pub(crate) struct Processing {
     poll_misses: u64,
     frame_rx: Receiver<InFrame>,
     free_tx: Sender<Vec<u8>>,
-    cmd_rx: Receiver<Cmd>,
+    cmd_rx: Receiver<Request>,
     stats: Arc<Mutex<Stats>>,
     queue_dropped: Arc<AtomicU64>,
     recording: Option<Recording>,
@@ -255,39 +254,43 @@ impl Processing {
         self.fanout.sent_us.reset();
     }
 
-    fn command(&mut self, cmd: Cmd) {
-        match cmd {
-            Cmd::Edit(control, reply) => {
-                let r = self
-                    .pipeline
+    fn command(&mut self, request: Request) {
+        let Request { command, reply } = request;
+        let answer: Option<Reply> = match command {
+            Command::Edit(control) => Some(
+                self.pipeline
                     .handle_edit(&control)
-                    .map_err(|e| e.to_string());
-                let _ = reply.send(r);
-            }
-            Cmd::Client(peer, control, reply) => {
+                    .map_err(|e| Refusal::Edit(e.to_string())),
+            ),
+            Command::Client { peer, control } => {
                 let r = self.fanout.command(peer, &control);
                 self.pipeline.set_wanted(self.fanout.wanted());
-                let _ = reply.send(r);
+                Some(r.map_err(Refusal::Client))
             }
-            Cmd::SetModel(model, reply) => {
+            Command::SetModel(model) => {
                 self.pipeline.set_model(model);
-                let _ = reply.send(Ok(()));
+                Some(Ok(()))
             }
-            Cmd::RecordStart(path, raw, reply) => {
+            Command::RecordStart { path, raw } => {
                 // The new recording is checked first: a bad path leaves the old one running.
                 let r = Recording::start(&path, raw.as_deref()).map(|rec| {
                     if let Some(old) = self.recording.replace(rec) {
                         self.closing.push(close_in_background(old, None));
                     }
                 });
-                let _ = reply.send(r.map_err(|e| e.to_string()));
+                Some(r.map_err(|e| Refusal::Record(e.to_string())))
             }
-            Cmd::RecordStop(reply) => match self.recording.take() {
-                Some(rec) => self.closing.push(close_in_background(rec, Some(reply))),
-                None => {
-                    let _ = reply.send(Err("no recording in progress".to_string()));
+            Command::RecordStop => match self.recording.take() {
+                Some(rec) => {
+                    // Answered by the closing thread once the files are complete.
+                    self.closing.push(close_in_background(rec, Some(reply)));
+                    return;
                 }
+                None => Some(Err(Refusal::Record("no recording in progress".into()))),
             },
+        };
+        if let Some(answer) = answer {
+            let _ = reply.send(answer);
         }
     }
 }
@@ -300,9 +303,15 @@ fn finish_recording(rec: Recording) {
 
 /// Closes a recording on its own thread (each file ends with an fsync, which must not hold up
 /// the frames), answering `reply` when done.
-fn close_in_background(rec: Recording, reply: Option<Answer>) -> std::thread::JoinHandle<()> {
+fn close_in_background(
+    rec: Recording,
+    reply: Option<tokio::sync::oneshot::Sender<Reply>>,
+) -> std::thread::JoinHandle<()> {
     std::thread::spawn(move || {
-        let r = rec.finish().map(|_| ()).map_err(|e| e.to_string());
+        let r = rec
+            .finish()
+            .map(|_| ())
+            .map_err(|e| Refusal::Record(e.to_string()));
         if let Err(e) = &r {
             tracing::warn!(error = %e, "recording failed");
         }

@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 
 use replay::record::Recorder;
 
-use super::pipeline::Emitted;
-use super::streams::StreamKey;
+use crate::engine::pipeline::Emitted;
+use crate::engine::streams::StreamKey;
 
 /// Why a recording could not start or finish.
 #[derive(Debug, thiserror::Error)]

@@ -17,11 +17,11 @@ use anyhow::Result;
 use hdrhistogram::Histogram;
 use protocol::{Control, Profile};
 
-use super::clients::{ClientChange, Clients};
 use super::net::connect;
-use super::pipeline::{Emitted, ProfileMask};
 use super::stats::{SendCounters, Stats};
 use super::Config;
+use crate::engine::clients::{ClientChange, Clients};
+use crate::engine::pipeline::{Emitted, ProfileMask};
 
 /// How often dynamic subscriptions are checked for expiry.
 const EXPIRY_EVERY: Duration = Duration::from_secs(1);

@@ -20,17 +20,17 @@ use anyhow::{Context, Result};
 use crossbeam_channel::{Receiver, Sender};
 use ica_core::model::IcaModel;
 use tokio::net::UdpSocket;
-use tokio::sync::oneshot;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
-use super::control::{self, Cmd, ControlCtx};
-use super::pipeline::{Pipeline, PipelineConfig};
+use super::command::Request;
+use super::control::{self, ControlCtx};
 use super::processing::{Channels, InFrame, Processing};
 use super::sender::Fanout;
 use super::stats::Stats;
-use super::streams::Performer;
 use super::Config;
+use crate::engine::pipeline::{Pipeline, PipelineConfig};
+use crate::engine::streams::Performer;
 
 /// Pooled buffers kept for received datagrams.
 const POOL: usize = 256;
@@ -45,23 +45,13 @@ pub struct Bound {
     performers: Vec<Performer>,
 }
 
-/// Loads a model file on a blocking thread.
-///
-/// # Errors
-/// Unreadable or invalid file, named.
-pub async fn load_model(path: std::path::PathBuf) -> Result<IcaModel> {
-    tokio::task::spawn_blocking(move || crate::commands::load_model(&path))
-        .await
-        .context("model loader panicked")?
-}
-
 /// Binds both sockets and loads the models, so that a test learns the addresses before frames
 /// flow (`127.0.0.1:0` gives free ports).
 ///
 /// # Errors
 /// A socket that cannot be bound or a model that cannot be loaded.
 pub async fn bind(config: Config) -> Result<Bound> {
-    let model = load_model(config.model.clone()).await?;
+    let model = super::load_model(config.model.clone()).await?;
     bind_with(config, model).await
 }
 
@@ -74,7 +64,7 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
     let mut performers = Vec::with_capacity(config.performers.len());
     for p in &config.performers {
         let model = match &p.model {
-            Some(path) => Some(Arc::new(load_model(path.clone()).await?)),
+            Some(path) => Some(Arc::new(super::load_model(path.clone()).await?)),
             None => None,
         };
         performers.push(Performer {
@@ -127,7 +117,7 @@ impl Bound {
         let queue_dropped = Arc::new(AtomicU64::new(0));
         let (frame_tx, frame_rx) = crossbeam_channel::bounded::<InFrame>(self.config.queue);
         let (free_tx, free_rx) = crossbeam_channel::bounded::<Vec<u8>>(POOL);
-        let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Cmd>(64);
+        let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Request>(64);
 
         let current_model = Arc::new(Mutex::new(Arc::clone(&self.model)));
         let pipeline = Pipeline::new(
@@ -238,6 +228,3 @@ async fn log_stats(stats: Arc<Mutex<Stats>>, every: Duration, shutdown: Cancella
         }
     }
 }
-
-/// Replies to a control message's sender: an `oneshot` answer from the processing thread.
-pub(crate) type Answer = oneshot::Sender<Result<(), String>>;

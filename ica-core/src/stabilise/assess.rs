@@ -16,8 +16,20 @@
 
 use nalgebra::{Matrix3, SMatrix, SVector, SymmetricEigen, Vector3};
 
-use super::search::{quantile, MarkerFrames, MIN_MOTION_MM, MOTION_FACTOR, RIGID_NOISE_FACTOR};
+use super::sample::Sample;
 use super::{centre, kabsch, point, Pose};
+use crate::robust::median;
+
+/// Head motion counts as measurable when it moves the face by more than this many times the
+/// pose error the reference itself would add...
+pub const MOTION_FACTOR: f64 = 3.0;
+/// ...and by more than this (mm RMS).
+pub const MIN_MOTION_MM: f64 = 0.3;
+/// Deformation (mm RMS per marker) below this multiple of the noise of one 3-D sample
+/// (`√3 σ`) counts as rigid within the capture's noise (a rigid band measures 1.0x on the
+/// synthetic face, its estimate varies by about 3 %; one holding an upper forehead that rises
+/// 1.5 mm with the brows 1.2x to 1.3x).
+pub const RIGID_NOISE_FACTOR: f64 = 1.1;
 
 /// The assessment of one candidate reference group. See the module docs.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,127 +58,6 @@ impl GroupAssessment {
     /// [`MOTION_FACTOR`] × the pose error it adds, and more than [`MIN_MOTION_MM`].
     pub fn motion_is_measurable(&self) -> bool {
         self.motion_mm > MOTION_FACTOR * self.pose_error_mm && self.motion_mm > MIN_MOTION_MM
-    }
-}
-
-/// Sampled frames, each with its two neighbours, glitches masked.
-pub(crate) struct Sample {
-    /// 3 frames per sample (before, at, after), markers x 3 each.
-    xyz: Vec<f32>,
-    /// Present (not missing, not a glitch), 3 frames per sample, markers each.
-    present: Vec<bool>,
-    markers: usize,
-    pub(crate) glitches: usize,
-}
-
-/// Glitch speed: this multiple of the 99.9th percentile speed, at least [`MIN_GLITCH_MM_S`]
-/// (per frame here: the sample has no rate, so speeds are mm per frame).
-const GLITCH_FACTOR: f64 = 4.0;
-/// Smallest glitch step, mm per frame.
-const MIN_GLITCH_STEP_MM: f64 = 4.0;
-
-impl Sample {
-    pub(crate) fn draw(frames: &MarkerFrames<'_>, max_frames: usize) -> Sample {
-        let n = frames.markers;
-        let inner: usize = frames.takes.iter().map(|r| r.len().saturating_sub(2)).sum();
-        let stride = (inner / max_frames.max(1)).max(1);
-        let mut xyz = Vec::new();
-        let mut present = Vec::new();
-        let mut k = 0usize;
-        for take in frames.takes {
-            for f in take.start + 1..take.end.saturating_sub(1) {
-                k += 1;
-                if k % stride != 0 {
-                    continue;
-                }
-                for g in f - 1..=f + 1 {
-                    xyz.extend_from_slice(&frames.xyz[g * n * 3..(g + 1) * n * 3]);
-                    present.extend(frames.missing[g * n..(g + 1) * n].iter().map(|m| !m));
-                }
-            }
-        }
-        let mut sample = Sample {
-            xyz,
-            present,
-            markers: n,
-            glitches: 0,
-        };
-        sample.mask_glitches();
-        sample
-    }
-
-    /// Sampled frames (centres).
-    pub(crate) fn frames(&self) -> usize {
-        self.present.len() / (3 * self.markers.max(1))
-    }
-
-    /// Storage indices of sample `s`'s three frames.
-    pub(crate) fn triple(&self, s: usize) -> [usize; 3] {
-        [3 * s, 3 * s + 1, 3 * s + 2]
-    }
-
-    /// A present sample's x y z.
-    pub(crate) fn get(&self, frame: usize, marker: usize) -> Option<&[f32]> {
-        let i = frame * self.markers + marker;
-        self.present[i].then(|| &self.xyz[i * 3..i * 3 + 3])
-    }
-
-    fn step(&self, a: usize, b: usize, m: usize) -> Option<f64> {
-        Some((point(self.get(a, m)?, 0) - point(self.get(b, m)?, 0)).norm())
-    }
-
-    /// Marks samples whose step to a neighbour is a glitch (see [`GLITCH_FACTOR`]).
-    fn mask_glitches(&mut self) {
-        let mut steps = Vec::new();
-        for s in 0..self.frames() {
-            let [b, a, n] = self.triple(s);
-            for m in 0..self.markers {
-                steps.extend(self.step(b, a, m));
-                steps.extend(self.step(a, n, m));
-            }
-        }
-        let limit = (GLITCH_FACTOR * quantile(&mut steps, 0.999)).max(MIN_GLITCH_STEP_MM);
-        for s in 0..self.frames() {
-            let [b, a, n] = self.triple(s);
-            for m in 0..self.markers {
-                let jump = |x: Option<f64>| x.is_some_and(|v| v > limit);
-                if jump(self.step(b, a, m)) || jump(self.step(a, n, m)) {
-                    for g in [b, a, n] {
-                        let i = g * self.markers + m;
-                        self.glitches += usize::from(self.present[i]);
-                        self.present[i] = false;
-                    }
-                }
-            }
-        }
-    }
-
-    pub(crate) fn present_share(&self, m: usize) -> f64 {
-        let at = (0..self.frames()).filter(|&s| self.get(3 * s + 1, m).is_some());
-        at.count() as f64 / self.frames().max(1) as f64
-    }
-
-    /// Median over `markers` and axes of the robust spread of second differences / √6.
-    pub(crate) fn noise_mm(&self, markers: &[usize]) -> f64 {
-        let mut per_axis = Vec::new();
-        let mut d2 = Vec::new();
-        for &m in markers {
-            for axis in 0..3 {
-                d2.clear();
-                for s in 0..self.frames() {
-                    let [b, a, n] = self.triple(s);
-                    if let (Some(p), Some(q), Some(r)) =
-                        (self.get(b, m), self.get(a, m), self.get(n, m))
-                    {
-                        d2.push(f64::from(p[axis]) - 2.0 * f64::from(q[axis]) + f64::from(r[axis]));
-                    }
-                }
-                if d2.len() >= 10 {
-                    per_axis.push(super::search::mad(&mut d2) / 6f64.sqrt());
-                }
-            }
-        }
-        super::search::median(&mut per_axis)
     }
 }
 
@@ -397,7 +288,7 @@ fn leakage(sample: &Sample, fits: &[(usize, Fitted)], others: &[usize]) -> f64 {
             explained_share(&rows)
         })
         .collect();
-    super::search::median(&mut shares)
+    median(&mut shares)
 }
 
 /// Share of the variance of `y` explained by a least-squares fit on `x` (with intercept).

@@ -16,12 +16,12 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 mod assess;
+mod sample;
 pub mod search;
 
 pub use assess::GroupAssessment;
-pub use search::{
-    assess_named, choose, search_reference, Choice, MarkerFrames, ReferenceSearch, SearchParams,
-};
+pub use sample::MarkerFrames;
+pub use search::{assess_named, choose, search_reference, Choice, ReferenceSearch, SearchParams};
 
 /// Why stabilisation could not be set up.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -19,10 +19,12 @@
 //! [`choose`] then picks, among the candidates least tied to the face, the one with the
 //! smallest pose error at the face.
 
-use std::ops::Range;
-
-use super::assess::{assess_group, GroupAssessment, Sample};
+use super::assess::{assess_group, GroupAssessment};
 use super::point;
+use super::sample::{MarkerFrames, Sample};
+use crate::robust::{mad, median};
+
+pub use super::assess::{MIN_MOTION_MM, MOTION_FACTOR, RIGID_NOISE_FACTOR};
 
 /// Largest strain (excess spread / length) of a rigid pair. See the module docs.
 pub const RIGID_STRAIN: f64 = 0.01;
@@ -35,17 +37,6 @@ pub const FACE_LEAKAGE: f64 = 0.6;
 /// motion follows the expression every head-like group leaks alike (0.26 to 0.46 on
 /// Facial-Sing).
 pub const LEAKAGE_TOLERANCE: f64 = 0.05;
-/// Head motion counts as measurable when it moves the face by more than this many times the
-/// pose error the reference itself would add...
-pub const MOTION_FACTOR: f64 = 3.0;
-/// ...and by more than this (mm RMS).
-pub const MIN_MOTION_MM: f64 = 0.3;
-/// Deformation (mm RMS per marker) below this multiple of the noise of one 3-D sample
-/// (`√3 σ`) counts as rigid within the capture's noise (a rigid band measures 1.0x on the
-/// synthetic face, its estimate varies by about 3 %; one holding an upper forehead that rises
-/// 1.5 mm with the brows 1.2x to 1.3x).
-pub const RIGID_NOISE_FACTOR: f64 = 1.1;
-
 /// Knobs of [`search_reference`]; the defaults are the documented constants.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SearchParams {
@@ -71,20 +62,6 @@ impl Default for SearchParams {
             least_deforming: 6,
         }
     }
-}
-
-/// Frames of a capture in one marker order: `xyz` frames x markers x 3 (mm), `missing` frames
-/// x markers, and the frame range of each take (differences never cross a take boundary).
-#[derive(Debug, Clone, Copy)]
-pub struct MarkerFrames<'a> {
-    /// Positions, frames x markers x 3 (mm).
-    pub xyz: &'a [f32],
-    /// Missing flags, frames x markers.
-    pub missing: &'a [bool],
-    /// Markers per frame.
-    pub markers: usize,
-    /// Frame range of each take.
-    pub takes: &'a [Range<usize>],
 }
 
 /// What [`search_reference`] measured.
@@ -344,29 +321,6 @@ fn least_deforming(pairs: &PairTable, count: usize) -> Vec<usize> {
     pairs.to_markers(&group)
 }
 
-/// Median (reorders `v`); 0 when empty.
-pub(crate) fn median(v: &mut [f64]) -> f64 {
-    quantile(v, 0.5)
-}
-
-/// `q`-quantile by selection (reorders `v`); 0 when empty.
-pub(crate) fn quantile(v: &mut [f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let k = ((v.len() - 1) as f64 * q).round() as usize;
-    *v.select_nth_unstable_by(k, f64::total_cmp).1
-}
-
-/// `1.4826 · MAD`, a robust standard deviation (reorders `v`).
-pub(crate) fn mad(v: &mut [f64]) -> f64 {
-    let m = median(v);
-    for x in v.iter_mut() {
-        *x = (*x - m).abs();
-    }
-    1.4826 * median(v)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -450,7 +404,7 @@ mod tests {
 
     fn decide(head: bool) -> Choice {
         let (xyz, missing) = scene(3000, head);
-        let takes = vec![Range {
+        let takes = vec![std::ops::Range {
             start: 0,
             end: 3000,
         }];

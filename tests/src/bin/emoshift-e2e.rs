@@ -6,5 +6,5 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
-    daemon::exit::main_with(daemon::cli::Cli::parse())
+    daemon::commands::main_with(daemon::cli::Cli::parse())
 }

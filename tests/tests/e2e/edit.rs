@@ -3,9 +3,9 @@
 
 use std::time::Duration;
 
-use daemon::layout::LabelMap;
+use daemon::engine::edit_state::{EditState, DEFAULT_LOWPASS_S};
+use daemon::engine::layout::LabelMap;
 use daemon::offline;
-use daemon::serve::edit_state::{EditState, DEFAULT_LOWPASS_S};
 use ica_core::edit::FrameEdit;
 use protocol::{Control, Profile, Reply};
 
@@ -98,7 +98,7 @@ async fn every_frame_comes_out_edited_exactly_as_offline() {
 async fn an_emotion_space_target_and_mix_come_out_as_offline_and_the_list_names_them() {
     let dir = tempfile::tempdir().expect("temp dir");
     let path = dir.path().join("space.json");
-    let model = daemon::serve::synthetic::random_space_model(MARKERS, COMPONENTS, 5);
+    let model = daemon::loopback::synthetic::random_space_model(MARKERS, COMPONENTS, 5);
     write_model(&model, &path);
     let d = start(&path, vec![]).await;
     let control = ControlClient::new(d.control).await;

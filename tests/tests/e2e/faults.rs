@@ -97,7 +97,7 @@ async fn a_corrupt_model_reload_keeps_the_old_model_and_answers_an_error() {
     // A good model swaps in without losing a frame.
     let good = m.dir.path().join("other.json");
     write_model(
-        &daemon::serve::synthetic::random_model(MARKERS, COMPONENTS, 99),
+        &daemon::loopback::synthetic::random_model(MARKERS, COMPONENTS, 99),
         &good,
     );
     let reply = control

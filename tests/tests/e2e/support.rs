@@ -5,8 +5,8 @@ use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use daemon::loopback::synthetic::{frame_into, random_model};
 use daemon::serve::config::RawConfig;
-use daemon::serve::synthetic::{frame_into, random_model};
 use ica_core::model::IcaModel;
 use protocol::{
     decode_frame_into, decode_reply, encode_control_into, encode_frame_into, encode_labels_into,

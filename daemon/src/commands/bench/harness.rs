@@ -17,10 +17,10 @@ use tokio::net::UdpSocket;
 use tokio_util::sync::CancellationToken;
 
 use super::MARKERS;
+use crate::loopback::synthetic::{frame_into, labels_datagram};
 use crate::serve::config::RawConfig;
 use crate::serve::net::{bind_receiver, bind_receiver_std};
 use crate::serve::stats::Stats;
-use crate::serve::synthetic::{frame_into, labels_datagram};
 
 /// What the receivers saw.
 pub(super) struct Seen {

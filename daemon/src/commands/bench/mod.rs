@@ -21,8 +21,8 @@ use ica_core::model::IcaModel;
 use protocol::{encode_frame_into, FrameBuf};
 
 use crate::cli::BenchArgs;
-use crate::serve::pipeline::{Pipeline, PipelineConfig};
-use crate::serve::synthetic::{frame_into, labels_datagram, random_model};
+use crate::engine::pipeline::{Pipeline, PipelineConfig};
+use crate::loopback::synthetic::{frame_into, labels_datagram, random_model};
 use harness::{through_daemon, through_relay, Run};
 
 const MARKERS: usize = 109;

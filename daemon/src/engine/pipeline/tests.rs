@@ -7,8 +7,8 @@ use protocol::{
 };
 
 use super::*;
-use crate::frame::FrameProcessor;
-use crate::serve::synthetic::{frame_into, random_model};
+use crate::engine::frame::FrameProcessor;
+use crate::loopback::synthetic::{frame_into, random_model};
 
 const MARKERS: usize = 12;
 

@@ -11,8 +11,8 @@ use std::sync::Arc;
 use ica_core::model::IcaModel;
 
 use super::edit_state::EditState;
-use crate::frame::FrameProcessor;
-use crate::layout::{LabelMap, LayoutError};
+use crate::engine::frame::FrameProcessor;
+use crate::engine::layout::{LabelMap, LayoutError};
 
 /// A backwards jump of more than this many frames is a restarted source (a looping replay, a
 /// restarted capture), not a late frame: the stream starts over instead of dropping it.
@@ -320,7 +320,7 @@ mod tests {
     use super::*;
 
     pub(crate) fn tiny_model() -> IcaModel {
-        super::super::synthetic::random_model(4, 2, 1)
+        crate::loopback::synthetic::random_model(4, 2, 1)
     }
 
     #[test]
@@ -366,7 +366,7 @@ mod vmc_tests {
     use ica_core::model::Role;
 
     use super::vmc_names;
-    use crate::serve::synthetic::random_model;
+    use crate::loopback::synthetic::random_model;
 
     #[test]
     fn labelled_components_get_blend_names() {

@@ -16,9 +16,9 @@ use protocol::{
     LayoutChange, Limits, Profile, ETHERNET_PAYLOAD,
 };
 
-use crate::serve::edit_state::EditRefused;
-use crate::serve::stats::Counters;
-use crate::serve::streams::{Order, Performer, Stream, StreamKey, Streams};
+use crate::engine::edit_state::EditRefused;
+use crate::engine::streams::{Order, Performer, Stream, StreamKey, Streams};
+use crate::engine::Counters;
 
 mod encode;
 mod setup;
@@ -73,7 +73,7 @@ pub struct PipelineConfig {
 impl Default for PipelineConfig {
     fn default() -> Self {
         PipelineConfig {
-            lowpass_s: crate::serve::edit_state::DEFAULT_LOWPASS_S,
+            lowpass_s: crate::engine::edit_state::DEFAULT_LOWPASS_S,
             max_markers: 1_000,
         }
     }
@@ -88,7 +88,7 @@ pub struct Pipeline {
     layouts: LayoutBook<SocketAddr>,
     streams: Streams,
     /// Settings of the default model's streams, copied into new streams.
-    template: crate::serve::edit_state::EditState,
+    template: crate::engine::edit_state::EditState,
     limits: Limits,
     frame_in: FrameBuf,
     frame_out: FrameBuf,
@@ -106,7 +106,7 @@ pub struct Pipeline {
 impl Pipeline {
     /// A pipeline over `model`, with optional named performers.
     pub fn new(model: Arc<IcaModel>, performers: Vec<Performer>, config: PipelineConfig) -> Self {
-        let template = crate::serve::edit_state::EditState::for_model(&model, config.lowpass_s);
+        let template = crate::engine::edit_state::EditState::for_model(&model, config.lowpass_s);
         Pipeline {
             layouts: LayoutBook::new(MAX_SOURCES),
             streams: Streams::new(MAX_SOURCES),
@@ -144,7 +144,7 @@ impl Pipeline {
     }
 
     /// Each stream's counters.
-    pub fn stream_status(&self) -> Vec<crate::serve::streams::StreamStatus> {
+    pub fn stream_status(&self) -> Vec<crate::engine::streams::StreamStatus> {
         self.streams.status(&self.performers)
     }
 
@@ -152,7 +152,7 @@ impl Pipeline {
     /// rebuilt on it, keeping their edit settings; no frame is dropped.
     pub fn set_model(&mut self, model: Arc<IcaModel>) {
         let mut template =
-            crate::serve::edit_state::EditState::for_model(&model, self.config.lowpass_s);
+            crate::engine::edit_state::EditState::for_model(&model, self.config.lowpass_s);
         template.copy_settings(&self.template);
         self.template = template;
         let old = Arc::clone(&self.model);

@@ -18,7 +18,7 @@ pub fn profile_bit(p: Profile) -> ProfileMask {
 pub(super) fn encode(
     wanted: ProfileMask,
     frame: &FrameBuf,
-    edit: &crate::serve::edit_state::EditState,
+    edit: &crate::engine::edit_state::EditState,
     (u, vmc): (&[f32], &[(String, usize)]),
     split: &FlatSplit,
     [compact, components, part, parts]: [&mut Vec<u8>; 4],

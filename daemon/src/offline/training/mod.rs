@@ -28,8 +28,8 @@ use ica_core::stabilise::{MarkerFrames, Stabiliser};
 
 pub use head::{HeadChoice, DEFAULT_HEAD_PATTERNS};
 
-use crate::frame::FramePrep;
-use crate::layout::LabelMap;
+use crate::engine::frame::FramePrep;
+use crate::engine::layout::LabelMap;
 use crate::offline::{self, LoadedTake, ModelFrames};
 
 /// Multiple of the 99.9th percentile speed that marks a glitch when the limit is automatic.

@@ -5,8 +5,8 @@ use std::sync::Arc;
 use ica_core::model::IcaModel;
 use protocol::Control;
 
-use crate::serve::edit_state::EditRefused;
-use crate::serve::streams::{Performer, Stream, StreamKey};
+use crate::engine::edit_state::EditRefused;
+use crate::engine::streams::{Performer, Stream, StreamKey};
 
 /// A new stream for `key` on its performer's model (or the default one, with the template's
 /// edit settings); `None` when its labels share none with the model.
@@ -15,7 +15,7 @@ pub(super) fn new_stream(
     source_labels: &[String],
     performers: &[Performer],
     default_model: &Arc<IcaModel>,
-    template: &crate::serve::edit_state::EditState,
+    template: &crate::engine::edit_state::EditState,
     lowpass_s: f32,
 ) -> Option<Stream> {
     let performer = performers.iter().position(|p| p.owns(key));
@@ -48,12 +48,15 @@ fn defaults_of(p: &Performer, stream: &mut Stream) {
     }
     stream
         .edit
-        .set_ramp(crate::serve::edit_state::DEFAULT_RAMP_S);
+        .set_ramp(crate::engine::edit_state::DEFAULT_RAMP_S);
 }
 
 /// The stream's source labels, rebuilt from its map for a model swap (unmapped source markers
 /// get placeholder names that match nothing).
-pub(super) fn source_labels(map: &crate::layout::LabelMap, model_labels: &[String]) -> Vec<String> {
+pub(super) fn source_labels(
+    map: &crate::engine::layout::LabelMap,
+    model_labels: &[String],
+) -> Vec<String> {
     let n = map
         .model_to_take
         .iter()
@@ -81,7 +84,7 @@ pub fn mix_name(pairs: &[(String, f32)]) -> String {
 }
 
 fn set_blend(
-    edit: &mut crate::serve::edit_state::EditState,
+    edit: &mut crate::engine::edit_state::EditState,
     model: &IcaModel,
     name: &str,
     weights: &[(&str, f64)],
@@ -99,7 +102,7 @@ fn set_blend(
 
 /// Applies one edit control to one stream's state, validated against its model.
 pub fn apply_edit(
-    edit: &mut crate::serve::edit_state::EditState,
+    edit: &mut crate::engine::edit_state::EditState,
     model: &IcaModel,
     control: &Control,
 ) -> Result<(), EditRefused> {

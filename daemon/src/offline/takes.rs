@@ -9,8 +9,8 @@ use ica_core::project::FrameStatus;
 use replay::session::Session;
 use replay::Take;
 
-use crate::frame::{FrameProcessor, Prepared};
-use crate::layout::LabelMap;
+use crate::engine::frame::{FrameProcessor, Prepared};
+use crate::engine::layout::LabelMap;
 
 /// A take loaded from disk, with where it came from.
 #[derive(Debug, Clone)]
@@ -31,6 +31,16 @@ pub fn load_take(path: &Path) -> Result<Take> {
         bail!("{}: take has no frames", path.display());
     }
     Ok(take)
+}
+
+/// Loads and validates a model file, naming the file in the error.
+///
+/// # Errors
+/// Unreadable file, or not a valid model.
+pub fn load_model(path: &Path) -> Result<IcaModel> {
+    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    IcaModel::load(std::io::BufReader::new(file))
+        .with_context(|| format!("{}: not a valid model", path.display()))
 }
 
 /// Loads a session manifest, naming the file in the error.

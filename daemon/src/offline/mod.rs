@@ -1,0 +1,13 @@
+//! Offline work over takes and models, as library functions the commands and the demo call:
+//! loading and projecting takes ([`takes`]), preparing captures for training and the model's
+//! quality report ([`training`]), the analysis of a paired session ([`analysis`]), and edit
+//! planning ([`edit`]).
+
+pub mod analysis;
+pub mod takes;
+pub mod training;
+
+pub use takes::{
+    load_inputs, load_model, load_session, load_take, match_take, project_take, resynthesise,
+    to_model_order, LoadedTake, ModelFrames, Projected,
+};

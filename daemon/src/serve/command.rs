@@ -1,0 +1,77 @@
+//! The one message between the control task and the processing thread: a [`Command`] with the
+//! channel its [`Reply`] goes back on. Applied between frames, so a frame never sees a half
+//! applied setting.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use ica_core::model::IcaModel;
+use protocol::Control;
+use tokio::sync::oneshot;
+
+/// What the control task asks of the processing thread.
+#[derive(Debug)]
+pub(crate) enum Command {
+    /// An edit setting, for every stream.
+    Edit(Control),
+    /// `/subscribe` or `/unsubscribe` from a peer.
+    Client {
+        /// Who asked.
+        peer: SocketAddr,
+        /// The control message.
+        control: Control,
+    },
+    /// Swap in a validated model.
+    SetModel(Arc<IcaModel>),
+    /// Start recording the edited stream to `path`, and the raw input to `raw`.
+    RecordStart {
+        /// The edited stream's file.
+        path: PathBuf,
+        /// The raw input's file.
+        raw: Option<PathBuf>,
+    },
+    /// Stop recording.
+    RecordStop,
+}
+
+/// Why a command was refused: the text `/emoshift/error` carries.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub(crate) enum Refusal {
+    /// Not a control message emoshift accepts (malformed, unknown address, bad argument).
+    #[error("{0}")]
+    Invalid(String),
+    /// The engine refused an edit (unknown emotion, component out of range, ...).
+    #[error("{0}")]
+    Edit(String),
+    /// A subscription change was refused.
+    #[error("{0}")]
+    Client(String),
+    /// A recording could not start or stop.
+    #[error("{0}")]
+    Record(String),
+    /// A model file could not be loaded.
+    #[error("{0}")]
+    Model(String),
+    /// The processing thread did not take the command (queue full or stopped).
+    #[error("the processing thread is busy or stopped")]
+    Busy,
+    /// The processing thread did not answer in time.
+    #[error("no answer from the processing thread")]
+    Timeout,
+    /// The daemon is shutting down.
+    #[error("shutting down")]
+    ShuttingDown,
+}
+
+/// The processing thread's answer to a [`Command`].
+pub(crate) type Reply = Result<(), Refusal>;
+
+/// A [`Command`] and where its [`Reply`] goes.
+#[derive(Debug)]
+pub(crate) struct Request {
+    /// What to do.
+    pub(crate) command: Command,
+    /// Where the answer goes.
+    pub(crate) reply: oneshot::Sender<Reply>,
+}

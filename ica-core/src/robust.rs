@@ -1,0 +1,24 @@
+//! Robust statistics on scratch slices: median, quantiles, the MAD.
+
+/// Median (reorders `v`); 0 when empty.
+pub(crate) fn median(v: &mut [f64]) -> f64 {
+    quantile(v, 0.5)
+}
+
+/// `q`-quantile by selection (reorders `v`); 0 when empty.
+pub(crate) fn quantile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let k = ((v.len() - 1) as f64 * q).round() as usize;
+    *v.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
+/// `1.4826 · MAD`, a robust standard deviation (reorders `v`).
+pub(crate) fn mad(v: &mut [f64]) -> f64 {
+    let m = median(v);
+    for x in v.iter_mut() {
+        *x = (*x - m).abs();
+    }
+    1.4826 * median(v)
+}
