@@ -203,6 +203,52 @@ pub fn warp_map(path: &[(usize, usize)], n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Each `dim`-wide column of a frames x dim series minus its mean over the frames: an offset
+/// constant over a take (an emotion level) shifts every DTW cell of a pair equally at best and
+/// biases the path at worst, so alignment looks at the motion around the level.
+pub fn demeaned(series: &[f64], dim: usize) -> Vec<f64> {
+    let frames = (series.len() / dim.max(1)).max(1) as f64;
+    let mut mean = vec![0.0; dim];
+    for row in series.chunks_exact(dim) {
+        for (acc, v) in mean.iter_mut().zip(row) {
+            *acc += v / frames;
+        }
+    }
+    series
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v - mean[i % dim])
+        .collect()
+}
+
+/// For each frame of `target`, the fractional frame of `source` it matches: DTW of the two
+/// demeaned series (frames x `dim`), Sakoe-Chiba `band`, averaged per target frame.
+///
+/// # Errors
+/// As [`align`].
+pub fn warp_onto(
+    target: &[f64],
+    source: &[f64],
+    dim: usize,
+    band: Option<usize>,
+) -> Result<Vec<f64>, DtwError> {
+    let alignment = align(&demeaned(target, dim), &demeaned(source, dim), dim, band)?;
+    Ok(warp_map(&alignment.path, target.len() / dim.max(1)))
+}
+
+/// `values` read at fractional frames `at` by linear interpolation (clamped to the ends).
+pub fn resample_at(values: &[f64], at: &[f64]) -> Vec<f64> {
+    let last = values.len().saturating_sub(1);
+    at.iter()
+        .map(|&j| {
+            let lo = (j.max(0.0).floor() as usize).min(last);
+            let hi = (lo + 1).min(last);
+            let t = (j - lo as f64).clamp(0.0, 1.0);
+            values[lo] * (1.0 - t) + values[hi] * t
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,16 +3,17 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use ica_core::fit::{Components, FastIcaParams, FitData};
-use ica_core::measure::{noise_per_coordinate, TrainingFrames};
+use ica_core::fit::FastIcaParams;
 use ica_core::model::IcaModel;
 use ica_core::whiten::DEFAULT_VARIANCE_TARGET;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 
 use crate::cli::TrainArgs;
 use crate::exit::UsageError;
 use crate::offline;
-use crate::offline::training::{self, HeadChoice, PrepOptions, PreparedData, SpeedLimit};
+use crate::offline::training::{
+    self, HeadChoice, PrepOptions, PreparedData, SpeedLimit, Stage, TrainOptions, Trained,
+};
 use replay::session::Regions;
 
 /// The regions file's region naming the rigid head markers.
@@ -79,73 +80,44 @@ fn params(args: &TrainArgs) -> Result<FastIcaParams> {
     Ok(params)
 }
 
+/// The training options a command line asks for.
+pub(crate) fn options(args: &TrainArgs) -> Result<TrainOptions> {
+    let regions = regions(args)?;
+    Ok(TrainOptions {
+        prep: PrepOptions {
+            rate_hz: args.rate,
+            max_missing_share: args.max_missing,
+            speed: speed_limit(&args.max_speed)?,
+            head: head_choice(args, regions.as_ref()),
+            bounds: !args.no_bounds,
+        },
+        params: params(args)?,
+        noise_floor: args.components.is_none() && args.variance.is_none(),
+        regions,
+    })
+}
+
 pub(crate) fn run(args: &TrainArgs) -> Result<()> {
-    let params = params(args)?;
+    let options = options(args)?;
     let started = Instant::now();
-    let bar = ProgressBar::new(0).with_style(
-        ProgressStyle::with_template("{spinner} {msg} [{bar:30}] {pos}/{len}")
-            .expect("static template")
-            .progress_chars("=> "),
-    );
+    let bar = ProgressBar::new_spinner();
     bar.set_message("loading takes");
     let takes = offline::load_inputs(args.manifest.as_deref(), &args.files)?;
-    bar.set_length(takes.len() as u64);
-    bar.set_position(takes.len() as u64);
-    let regions = regions(args)?;
-    let options = PrepOptions {
-        rate_hz: args.rate,
-        max_missing_share: args.max_missing,
-        speed: speed_limit(&args.max_speed)?,
-        head: head_choice(args, regions.as_ref()),
-        bounds: !args.no_bounds,
-    };
-    let data = training::prepare(&takes, &options)?;
-    let channels = data.labels.len() * 3;
-    // With no count or share asked for, the default share stops at the capture's noise floor.
-    let noise_mm = noise_per_coordinate(&TrainingFrames {
-        samples: &data.samples,
-        missing: &data.missing,
-        channels,
-        takes: &data.takes,
-        rate_hz: data.rate_hz,
-    });
-    let params = if args.components.is_none() && args.variance.is_none() && noise_mm > 0.0 {
-        params.components(Components::VarianceAboveNoise {
-            target: DEFAULT_VARIANCE_TARGET,
-            noise_var: noise_mm * noise_mm,
-        })
-    } else {
-        params
-    };
-    // Gaps (occlusions, glitches) are filled for training, so frames with a gap still teach
-    // the model; `data` keeps the real samples for the quality report.
-    let mut filled = data.samples.clone();
-    let (still_missing, gaps) = ica_core::impute::fill_gaps(
-        &mut filled,
-        &data.missing,
-        channels,
-        params.get_components(),
-    )
-    .context("training failed")?;
-    let fit_data = FitData::new(&filled, channels)?.with_missing(&still_missing)?;
-    bar.set_style(ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("static"));
-    bar.set_message(format!(
-        "whitening and FastICA ({} restarts)",
-        args.restarts
-    ));
-    bar.enable_steady_tick(std::time::Duration::from_millis(120));
-    let fit = params.fit(&fit_data).context("training failed")?;
+    let trained = training::train(&takes, &options, &mut |stage| match stage {
+        Stage::Preparing => bar.set_message(format!("preparing {} takes", takes.len())),
+        Stage::Fitting { restarts } => {
+            bar.set_message(format!("whitening and FastICA ({restarts} restarts)"));
+            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        }
+    })?;
     bar.finish_and_clear();
-    let mut model = IcaModel::new(
-        data.labels.clone(),
-        data.rate_hz,
-        fit.mean,
-        fit.mixing,
-        fit.report,
-    )
-    .context("the fitted model failed validation")?;
-    model.set_capture(data.capture.clone())?;
-    model.set_quality(training::quality::assess(&model, &data, regions.as_ref()));
+    let Trained {
+        model,
+        data,
+        gaps,
+        noise_mm,
+        capped_at_noise,
+    } = trained;
     let file = std::fs::File::create(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     model
@@ -161,11 +133,7 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
         );
     }
     print_summary(&model, takes.len(), started.elapsed().as_secs_f64())?;
-    if matches!(
-        params.get_components(),
-        Components::VarianceAboveNoise { .. }
-    ) && model.variance_kept() < DEFAULT_VARIANCE_TARGET
-    {
+    if capped_at_noise {
         crate::out!(
             "the default {:.0} % of the variance would reach into noise ({noise_mm:.3} mm per coordinate): kept the {} components above the noise floor",
             100.0 * DEFAULT_VARIANCE_TARGET,

@@ -4,6 +4,7 @@
 //! planning ([`edit`]).
 
 pub mod analysis;
+pub mod edit;
 pub mod takes;
 pub mod training;
 

@@ -120,6 +120,11 @@ impl FastIcaParams {
         self.components
     }
 
+    /// Restarts.
+    pub fn get_restarts(&self) -> usize {
+        self.restarts
+    }
+
     /// The iteration cap.
     pub fn get_max_iter(&self) -> usize {
         self.max_iter

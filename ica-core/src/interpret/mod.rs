@@ -69,23 +69,6 @@ fn frames_of(series: &[f64], m: usize) -> Result<usize, InterpretError> {
     Ok(series.len() / m)
 }
 
-/// Each component minus its mean over the take: an emotion level that is constant within a take
-/// shifts every DTW cell of a pair equally at best, and biases the path at worst, so alignment
-/// looks at the motion around the level.
-fn demeaned(series: &[f64], m: usize, frames: usize) -> Vec<f64> {
-    let mut mean = vec![0.0; m];
-    for row in series.chunks_exact(m) {
-        for (acc, v) in mean.iter_mut().zip(row) {
-            *acc += v / frames as f64;
-        }
-    }
-    series
-        .iter()
-        .enumerate()
-        .map(|(i, v)| v - mean[i % m])
-        .collect()
-}
-
 /// `d_emotion,j` over pairs of component series of the same sentence in two emotions.
 ///
 /// `band` is the DTW Sakoe-Chiba radius in frames (`None`: unconstrained).
@@ -100,8 +83,10 @@ pub fn emotion_distance(
     let mut sum = vec![0.0; m];
     let mut aligned_samples = Vec::with_capacity(pairs.len());
     for (a, b) in pairs {
-        let (na, nb) = (frames_of(a, m)?, frames_of(b, m)?);
-        let alignment = dtw::align(&demeaned(a, m, na), &demeaned(b, m, nb), m, band)?;
+        // Shapes checked first, for a typed error naming the series.
+        frames_of(a, m)?;
+        frames_of(b, m)?;
+        let alignment = dtw::align(&dtw::demeaned(a, m), &dtw::demeaned(b, m), m, band)?;
         for &(i, j) in &alignment.path {
             for (k, acc) in sum.iter_mut().enumerate() {
                 let d = a[i * m + k] - b[j * m + k];

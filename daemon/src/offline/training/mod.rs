@@ -17,6 +17,7 @@
 //! stored in the model.
 
 pub mod head;
+mod model;
 pub mod quality;
 
 use std::ops::Range;
@@ -27,6 +28,7 @@ use ica_core::quality::HeadReport;
 use ica_core::stabilise::{MarkerFrames, Stabiliser};
 
 pub use head::{HeadChoice, DEFAULT_HEAD_PATTERNS};
+pub use model::{train, Stage, TrainOptions, Trained};
 
 use crate::engine::frame::FramePrep;
 use crate::engine::layout::LabelMap;

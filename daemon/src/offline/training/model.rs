@@ -1,0 +1,132 @@
+//! From takes to a model, as `emoshift train` and the demo run it: prepare the captures
+//! ([`super::prepare`]), pick the component rule, fill the gaps for training, fit, and measure
+//! the model's quality.
+
+use anyhow::{Context, Result};
+use ica_core::fit::{Components, FastIcaParams, FitData};
+use ica_core::impute::{fill_gaps, GapFill};
+use ica_core::measure::{noise_per_coordinate, TrainingFrames};
+use ica_core::model::IcaModel;
+use ica_core::whiten::DEFAULT_VARIANCE_TARGET;
+use replay::session::Regions;
+
+use super::{prepare, PrepOptions, PreparedData};
+use crate::offline::LoadedTake;
+
+/// What to train with.
+#[derive(Debug, Clone)]
+pub struct TrainOptions {
+    /// How the captures are prepared (rate, markers, glitches, head).
+    pub prep: PrepOptions,
+    /// FastICA settings; the component rule is replaced when `noise_floor` is set.
+    pub params: FastIcaParams,
+    /// Nothing asked for the component count: the default share of the variance, stopped at
+    /// the capture's noise floor ([`Components::VarianceAboveNoise`]).
+    pub noise_floor: bool,
+    /// Regions, for the residuals per region in the quality report.
+    pub regions: Option<Regions>,
+}
+
+/// Where training is, for a progress display.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// Resampling, choosing markers, glitches, the head.
+    Preparing,
+    /// Whitening and FastICA with this many restarts.
+    Fitting {
+        /// Restarts.
+        restarts: usize,
+    },
+}
+
+/// A trained model and what training found on the way.
+#[derive(Debug)]
+pub struct Trained {
+    /// The model, its frame preparation and its quality report set.
+    pub model: IcaModel,
+    /// The prepared training data.
+    pub data: PreparedData,
+    /// Gaps filled for training.
+    pub gaps: GapFill,
+    /// The capture's noise per coordinate (mm).
+    pub noise_mm: f64,
+    /// The default variance share was cut short at the noise floor.
+    pub capped_at_noise: bool,
+}
+
+/// Trains a model on `takes`. See the module docs.
+///
+/// # Errors
+/// Preparation, gap filling or the fit refusing the data; a fitted model that fails validation.
+pub fn train(
+    takes: &[LoadedTake],
+    options: &TrainOptions,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<Trained> {
+    progress(Stage::Preparing);
+    let data = prepare(takes, &options.prep)?;
+    let channels = data.labels.len() * 3;
+    let noise_mm = noise_per_coordinate(&training_frames(&data));
+    let params = if options.noise_floor && noise_mm > 0.0 {
+        options
+            .params
+            .clone()
+            .components(Components::VarianceAboveNoise {
+                target: DEFAULT_VARIANCE_TARGET,
+                noise_var: noise_mm * noise_mm,
+            })
+    } else {
+        options.params.clone()
+    };
+    // Gaps (occlusions, glitches) are filled for training, so frames with a gap still teach
+    // the model; `data` keeps the real samples for the quality report.
+    let mut filled = data.samples.clone();
+    let (still_missing, gaps) = fill_gaps(
+        &mut filled,
+        &data.missing,
+        channels,
+        params.get_components(),
+    )
+    .context("training failed")?;
+    let fit_data = FitData::new(&filled, channels)?.with_missing(&still_missing)?;
+    progress(Stage::Fitting {
+        restarts: params.get_restarts(),
+    });
+    let fit = params.fit(&fit_data).context("training failed")?;
+    let mut model = IcaModel::new(
+        data.labels.clone(),
+        data.rate_hz,
+        fit.mean,
+        fit.mixing,
+        fit.report,
+    )
+    .context("the fitted model failed validation")?;
+    model.set_capture(data.capture.clone())?;
+    model.set_quality(super::quality::assess(
+        &model,
+        &data,
+        options.regions.as_ref(),
+    ));
+    let capped_at_noise = matches!(
+        params.get_components(),
+        Components::VarianceAboveNoise { .. }
+    ) && model.variance_kept() < DEFAULT_VARIANCE_TARGET;
+    Ok(Trained {
+        model,
+        data,
+        gaps,
+        noise_mm,
+        capped_at_noise,
+    })
+}
+
+/// The prepared data as the quality measures read it.
+pub(crate) fn training_frames(data: &PreparedData) -> TrainingFrames<'_> {
+    TrainingFrames {
+        samples: &data.samples,
+        missing: &data.missing,
+        channels: data.labels.len() * 3,
+        takes: &data.takes,
+        rate_hz: data.rate_hz,
+    }
+}
