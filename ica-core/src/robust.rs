@@ -1,12 +1,13 @@
-//! Robust statistics on scratch slices: median, quantiles, the MAD.
+//! Robust statistics on scratch slices: median, quantiles, the MAD. The one quantile rule of
+//! the workspace: the nearest rank, `round((n - 1)·q)`, found by selection.
 
 /// Median (reorders `v`); 0 when empty.
-pub(crate) fn median(v: &mut [f64]) -> f64 {
+pub fn median(v: &mut [f64]) -> f64 {
     quantile(v, 0.5)
 }
 
 /// `q`-quantile by selection (reorders `v`); 0 when empty.
-pub(crate) fn quantile(v: &mut [f64], q: f64) -> f64 {
+pub fn quantile(v: &mut [f64], q: f64) -> f64 {
     if v.is_empty() {
         return 0.0;
     }
@@ -15,7 +16,7 @@ pub(crate) fn quantile(v: &mut [f64], q: f64) -> f64 {
 }
 
 /// `1.4826 · MAD`, a robust standard deviation (reorders `v`).
-pub(crate) fn mad(v: &mut [f64]) -> f64 {
+pub fn mad(v: &mut [f64]) -> f64 {
     let m = median(v);
     for x in v.iter_mut() {
         *x = (*x - m).abs();

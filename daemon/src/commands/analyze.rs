@@ -1,29 +1,56 @@
 //! `emoshift analyze --model m.json --manifest session.toml [--regions r.toml] --out DIR
 //! [--write-model]`.
 
+use std::path::Path;
+
 use anyhow::{Context, Result};
+use ica_core::model::IcaModel;
 
 use crate::cli::AnalyzeArgs;
 use crate::offline;
 use crate::offline::analysis::{self, Inputs};
 
 pub(crate) fn run(args: &AnalyzeArgs) -> Result<()> {
-    let mut model = crate::offline::load_model(&args.model)?;
-    let session = offline::load_session(&args.manifest)?;
-    let regions_path = match &args.regions {
-        Some(p) => p.clone(),
+    let to = Report {
+        dir: &args.out,
+        write_model: args.write_model,
+    };
+    analyze_and_write(&args.model, &args.manifest, args.regions.as_deref(), &to).map(drop)
+}
+
+/// Where [`analyze_and_write`] puts its results.
+pub(crate) struct Report<'a> {
+    /// The report's folder.
+    pub dir: &'a Path,
+    /// Roles and emotion levels go into the model file too.
+    pub write_model: bool,
+}
+
+/// Analyses the model at `model_path` on the session at `manifest`, writes the report and
+/// prints the table, as `analyze` does; returns the model (with roles and levels when
+/// written back).
+pub(crate) fn analyze_and_write(
+    model_path: &Path,
+    manifest: &Path,
+    regions: Option<&Path>,
+    to: &Report<'_>,
+) -> Result<IcaModel> {
+    let mut model = crate::offline::load_model(model_path)?;
+    let session = offline::load_session(manifest)?;
+    let regions_path = match regions {
+        Some(p) => p.to_path_buf(),
         None => session.base_dir.join("regions.toml"),
     };
     let regions = analysis::resolve_regions(&regions_path, &model)?;
     let takes = analysis::project_session(&model, &session)?;
     let inputs = Inputs {
         model: &model,
-        model_path: &args.model,
-        manifest_path: &args.manifest,
+        model_path,
+        manifest_path: manifest,
         regions_path: &regions_path,
     };
     let report = analysis::analyze(&inputs, &takes, &regions)?;
-    let written = analysis::write_report(&args.out, &report, &takes)?;
+    let written = analysis::write_report(to.dir, &report, &takes)?;
     for c in &report.components {
         crate::out!(
             "c{:<2} {:<9} d_emotion {:>8} d_level {:>8} d_mouth {:>8.4} d_eyebrows {:>8.4} d_eyelids {:>8.4}",
@@ -42,15 +69,15 @@ pub(crate) fn run(args: &AnalyzeArgs) -> Result<()> {
     for (name, level) in &report.levels {
         crate::out!("level {name}: {level:.4}");
     }
-    if args.write_model {
+    if to.write_model {
         analysis::write_into_model(&mut model, &report)?;
-        let file = std::fs::File::create(&args.model)
-            .with_context(|| format!("cannot write {}", args.model.display()))?;
+        let file = std::fs::File::create(model_path)
+            .with_context(|| format!("cannot write {}", model_path.display()))?;
         model.save(std::io::BufWriter::new(file))?;
-        crate::out!("roles and levels written to {}", args.model.display());
+        crate::out!("roles and levels written to {}", model_path.display());
     }
     for p in written {
         crate::out!("wrote {}", p.display());
     }
-    Ok(())
+    Ok(model)
 }

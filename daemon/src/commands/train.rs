@@ -1,5 +1,6 @@
 //! `emoshift train`: learn an ICA model from takes.
 
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -10,10 +11,10 @@ use indicatif::ProgressBar;
 
 use crate::cli::TrainArgs;
 use crate::exit::UsageError;
-use crate::offline;
 use crate::offline::training::{
     self, HeadChoice, PrepOptions, PreparedData, SpeedLimit, Stage, TrainOptions, Trained,
 };
+use crate::offline::{self, LoadedTake};
 use replay::session::Regions;
 
 /// The regions file's region naming the rigid head markers.
@@ -29,12 +30,18 @@ fn regions(args: &TrainArgs) -> Result<Option<Regions>> {
         .transpose()
 }
 
-fn head_choice(args: &TrainArgs, regions: Option<&Regions>) -> HeadChoice {
+/// The head reference: `--head-reference`, else the regions file's `head_reference`, else
+/// auto with `patterns`.
+fn head_choice(
+    head_reference: Option<&str>,
+    patterns: &[String],
+    regions: Option<&Regions>,
+) -> HeadChoice {
     let auto = HeadChoice::Auto {
-        patterns: args.head_patterns.clone(),
+        patterns: patterns.to_vec(),
     };
-    if let Some(text) = &args.head_reference {
-        return match text.as_str() {
+    if let Some(text) = head_reference {
+        return match text {
             "none" => HeadChoice::None,
             "auto" => auto,
             list => HeadChoice::Labels(list.split(',').map(|s| s.trim().to_string()).collect()),
@@ -88,7 +95,11 @@ pub(crate) fn options(args: &TrainArgs) -> Result<TrainOptions> {
             rate_hz: args.rate,
             max_missing_share: args.max_missing,
             speed: speed_limit(&args.max_speed)?,
-            head: head_choice(args, regions.as_ref()),
+            head: head_choice(
+                args.head_reference.as_deref(),
+                &args.head_patterns,
+                regions.as_ref(),
+            ),
             bounds: !args.no_bounds,
         },
         params: params(args)?,
@@ -97,13 +108,31 @@ pub(crate) fn options(args: &TrainArgs) -> Result<TrainOptions> {
     })
 }
 
+/// The default options with a regions file (which may name the head reference).
+pub(crate) fn options_with_regions(regions: Regions) -> TrainOptions {
+    let mut options = TrainOptions::default();
+    let patterns = offline::training::DEFAULT_HEAD_PATTERNS.map(String::from);
+    options.prep.head = head_choice(None, &patterns, Some(&regions));
+    options.regions = Some(regions);
+    options
+}
+
 pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     let options = options(args)?;
+    let takes = offline::load_inputs(args.manifest.as_deref(), &args.files)?;
+    train_and_save(&takes, &options, &args.out).map(drop)
+}
+
+/// Trains on `takes`, writes the model to `out` and prints what training found, as `train`
+/// does; returns the model.
+pub(crate) fn train_and_save(
+    takes: &[LoadedTake],
+    options: &TrainOptions,
+    out: &Path,
+) -> Result<IcaModel> {
     let started = Instant::now();
     let bar = ProgressBar::new_spinner();
-    bar.set_message("loading takes");
-    let takes = offline::load_inputs(args.manifest.as_deref(), &args.files)?;
-    let trained = training::train(&takes, &options, &mut |stage| match stage {
+    let trained = training::train(takes, options, &mut |stage| match stage {
         Stage::Preparing => bar.set_message(format!("preparing {} takes", takes.len())),
         Stage::Fitting { restarts } => {
             bar.set_message(format!("whitening and FastICA ({restarts} restarts)"));
@@ -118,11 +147,11 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
         noise_mm,
         capped_at_noise,
     } = trained;
-    let file = std::fs::File::create(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let file =
+        std::fs::File::create(out).with_context(|| format!("cannot create {}", out.display()))?;
     model
         .save(std::io::BufWriter::new(file))
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
+        .with_context(|| format!("cannot write {}", out.display()))?;
     print_preparation(&data)?;
     if gaps.frames > 0 || gaps.frames_left_out > 0 {
         crate::out!(
@@ -141,8 +170,8 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
         );
     }
     super::inspect::print_quality(model.quality())?;
-    crate::out!("model: {}", args.out.display());
-    Ok(())
+    crate::out!("model: {}", out.display());
+    Ok(model)
 }
 
 fn print_preparation(data: &PreparedData) -> Result<()> {

@@ -1,4 +1,16 @@
-//! An in-process emoshift for the demo, `emoshift bench` and the end-to-end tests: synthetic
-//! models and frames ([`synthetic`]).
+//! One loopback harness for the demo, `emoshift bench` and the end-to-end tests: the daemon
+//! in this process ([`Daemon`]), paced sources ([`source`]), receivers ([`Receiver`]), a
+//! control client ([`ControlClient`]), and synthetic models and frames ([`synthetic`]).
+//! Everything binds 127.0.0.1 only. `emoshift replay` sends through the same [`Source`] and
+//! [`source::drive`], so a replay and a test source send alike.
 
+pub mod control;
+pub mod daemon;
+pub mod receiver;
+pub mod source;
 pub mod synthetic;
+
+pub use control::{counter, ControlClient};
+pub use daemon::Daemon;
+pub use receiver::{Collecting, Received, Receiver};
+pub use source::Source;

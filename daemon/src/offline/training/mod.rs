@@ -1,4 +1,4 @@
-//! Preparing real captures for training (issue "real captures"): one rate, markers that are
+//! Preparing real captures for training: one rate, markers that are
 //! mostly there, glitches removed, head motion taken out.
 //!
 //! 1. **Rates**: every take is resampled (linear) to the model rate, and the report says so.
@@ -16,6 +16,7 @@
 //! The same [`FramePrep`] then runs in `project`, `edit` and the daemon, from the settings
 //! stored in the model.
 
+mod glitches;
 pub mod head;
 mod model;
 pub mod quality;
@@ -23,21 +24,19 @@ pub mod quality;
 use std::ops::Range;
 
 use anyhow::{bail, Result};
-use ica_core::model::{CaptureSettings, MarkerBounds};
+use ica_core::model::CaptureSettings;
 use ica_core::quality::HeadReport;
+use ica_core::robust::quantile;
 use ica_core::stabilise::{MarkerFrames, Stabiliser};
 
+use glitches::{auto_speed, glitches_per_marker, marker_bounds};
+pub use glitches::{AUTO_SPEED_FACTOR, BOUNDS_FACTOR, MIN_AUTO_SPEED_MM_S, MIN_BOUNDS_MM};
 pub use head::{HeadChoice, DEFAULT_HEAD_PATTERNS};
 pub use model::{train, Stage, TrainOptions, Trained};
 
 use crate::engine::frame::FramePrep;
 use crate::engine::layout::LabelMap;
 use crate::offline::{self, LoadedTake, ModelFrames};
-
-/// Multiple of the 99.9th percentile speed that marks a glitch when the limit is automatic.
-pub const AUTO_SPEED_FACTOR: f64 = 4.0;
-/// Floor of the automatic speed limit (mm/s): faces do not move faster than this in a frame.
-pub const MIN_AUTO_SPEED_MM_S: f64 = 500.0;
 
 /// The glitch speed limit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +48,9 @@ pub enum SpeedLimit {
     /// This many mm/s.
     MmPerS(f64),
 }
+
+/// The default share of frames a marker may miss before it is left out.
+pub const DEFAULT_MAX_MISSING: f64 = 0.5;
 
 /// Options of [`prepare`].
 #[derive(Debug, Clone)]
@@ -63,6 +65,24 @@ pub struct PrepOptions {
     pub head: HeadChoice,
     /// Learn per-marker plausible regions and treat samples outside them as glitches.
     pub bounds: bool,
+}
+
+impl Default for PrepOptions {
+    /// What `emoshift train` does when asked nothing.
+    fn default() -> PrepOptions {
+        PrepOptions {
+            rate_hz: None,
+            max_missing_share: DEFAULT_MAX_MISSING,
+            speed: SpeedLimit::Auto,
+            head: HeadChoice::Auto {
+                patterns: DEFAULT_HEAD_PATTERNS
+                    .iter()
+                    .map(|p| p.to_string())
+                    .collect(),
+            },
+            bounds: true,
+        }
+    }
 }
 
 /// Training data in model order, head coordinates, with what preparing found.
@@ -108,9 +128,7 @@ impl PreparedData {
         if r.is_empty() {
             return None;
         }
-        r.sort_by(f64::total_cmp);
-        let at = |q: f64| r[((r.len() - 1) as f64 * q).round() as usize];
-        Some((at(0.5), at(0.95)))
+        Some((quantile(&mut r, 0.5), quantile(&mut r, 0.95)))
     }
 }
 
@@ -217,18 +235,6 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
 
 type PrepRun = (Vec<f32>, Vec<bool>, usize, Vec<f64>);
 
-/// Samples flagged missing after preparation but present in the input, per marker.
-fn glitches_per_marker(frames: &[ModelFrames], prepared_missing: &[bool], n: usize) -> Vec<usize> {
-    let input = frames.iter().flat_map(|f| f.missing.iter().copied());
-    let mut counts = vec![0; n];
-    for (i, (before, after)) in input.zip(prepared_missing).enumerate() {
-        if !before && *after {
-            counts[i % n] += 1;
-        }
-    }
-    counts
-}
-
 /// Runs every take through a fresh [`FramePrep`]: positions, per-marker mask, glitches,
 /// residuals.
 fn run_prep(
@@ -294,80 +300,6 @@ fn kept_markers(takes: &[replay::Take], max_share: f64) -> Result<KeptMarkers> {
         );
     }
     Ok((kept, excluded))
-}
-
-/// Radius of a marker's plausible ball: this multiple of the 99th percentile of its distance
-/// from its median position…
-pub const BOUNDS_FACTOR: f64 = 2.0;
-/// …but never below this (mm), so a nearly still marker keeps room for real motion.
-pub const MIN_BOUNDS_MM: f64 = 15.0;
-
-/// Per-marker ball: centre at the median position, radius [`BOUNDS_FACTOR`] × the 99th
-/// percentile distance from it, at least [`MIN_BOUNDS_MM`]. Medians and percentiles ignore the
-/// rare glitches they are meant to catch.
-fn marker_bounds(xyz: &[f32], missing: &[bool], n: usize) -> MarkerBounds {
-    let frames = missing.len() / n.max(1);
-    let mut centre = Vec::with_capacity(n);
-    let mut radius_mm = Vec::with_capacity(n);
-    let mut values = Vec::with_capacity(frames);
-    for m in 0..n {
-        let present: Vec<usize> = (0..frames).filter(|&f| !missing[f * n + m]).collect();
-        let mut c = [0.0f64; 3];
-        for (a, slot) in c.iter_mut().enumerate() {
-            values.clear();
-            values.extend(present.iter().map(|&f| f64::from(xyz[(f * n + m) * 3 + a])));
-            *slot = quantile(&mut values, 0.5).unwrap_or(0.0);
-        }
-        values.clear();
-        values.extend(present.iter().map(|&f| {
-            (0..3)
-                .map(|a| (f64::from(xyz[(f * n + m) * 3 + a]) - c[a]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        }));
-        let r = quantile(&mut values, 0.99).unwrap_or(0.0) * BOUNDS_FACTOR;
-        centre.push(c);
-        radius_mm.push(r.max(MIN_BOUNDS_MM));
-    }
-    MarkerBounds { centre, radius_mm }
-}
-
-fn quantile(values: &mut [f64], q: f64) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    let k = ((values.len() - 1) as f64 * q).round() as usize;
-    let (_, v, _) = values.select_nth_unstable_by(k, f64::total_cmp);
-    Some(*v)
-}
-
-/// [`AUTO_SPEED_FACTOR`] × the 99.9th percentile of per-frame marker speeds (mm/s), over
-/// frames concatenated take after take (`frames` gives the take boundaries).
-fn auto_speed(
-    xyz: &[f32],
-    missing: &[bool],
-    frames: &[ModelFrames],
-    n: usize,
-    rate_hz: f64,
-) -> Option<f64> {
-    let mut speeds = Vec::new();
-    let mut start = 0;
-    for take in frames {
-        for f in start + 1..start + take.frames() {
-            for m in 0..n {
-                if !missing[(f - 1) * n + m] && !missing[f * n + m] {
-                    let d2: f32 = (0..3)
-                        .map(|k| {
-                            (xyz[(f * n + m) * 3 + k] - xyz[((f - 1) * n + m) * 3 + k]).powi(2)
-                        })
-                        .sum();
-                    speeds.push(f64::from(d2.sqrt()) * rate_hz);
-                }
-            }
-        }
-        start += take.frames();
-    }
-    Some((quantile(&mut speeds, 0.999)? * AUTO_SPEED_FACTOR).max(MIN_AUTO_SPEED_MM_S))
 }
 
 /// RMS distance (mm) of each reference marker from its template place, over the prepared

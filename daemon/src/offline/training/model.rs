@@ -27,6 +27,18 @@ pub struct TrainOptions {
     pub regions: Option<Regions>,
 }
 
+impl Default for TrainOptions {
+    /// What `emoshift train` does when asked nothing.
+    fn default() -> TrainOptions {
+        TrainOptions {
+            prep: PrepOptions::default(),
+            params: FastIcaParams::default(),
+            noise_floor: true,
+            regions: None,
+        }
+    }
+}
+
 /// Where training is, for a progress display.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {

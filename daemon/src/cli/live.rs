@@ -1,0 +1,101 @@
+//! The arguments of the live commands: the service, its bench, replays and the demo.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+/// `emoshift serve`. Flags override the config file.
+#[derive(Debug, Args)]
+pub struct ServeArgs {
+    /// TOML config file (every flag has a key; see docs/emoshift.toml).
+    #[arg(long, env = "EMOSHIFT_CONFIG")]
+    pub config: Option<PathBuf>,
+    /// Model file (JSON).
+    #[arg(long, env = "EMOSHIFT_MODEL")]
+    pub model: Option<PathBuf>,
+    /// Frame socket, IP:PORT [default: 127.0.0.1:9000].
+    #[arg(long, value_name = "IP:PORT")]
+    pub listen: Option<String>,
+    /// Control socket, IP:PORT [default: 127.0.0.1:9001].
+    #[arg(long, value_name = "IP:PORT")]
+    pub control: Option<String>,
+    /// Static subscriber HOST:PORT[:profile] (compact, flat-split, components); repeatable,
+    /// replaces the config's list.
+    #[arg(long, value_name = "HOST:PORT[:PROFILE]")]
+    pub send: Vec<String>,
+    /// Low-pass window of the emotion edit, seconds [default: 1].
+    #[arg(long)]
+    pub lowpass: Option<f32>,
+}
+
+/// `emoshift bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Senders (performers), each at 120 Hz.
+    #[arg(long, default_value_t = 1)]
+    pub performers: usize,
+    /// Receivers (subscribers).
+    #[arg(long, default_value_t = 2)]
+    pub clients: usize,
+    /// Seconds of each timed run.
+    #[arg(long, default_value_t = 3.0)]
+    pub seconds: f64,
+    /// The daemon's `poll_window_us` (0: the processing thread always parks).
+    #[arg(long, default_value_t = crate::serve::config::DEFAULT_POLL_WINDOW_US)]
+    pub poll_window_us: u64,
+}
+
+/// `emoshift replay`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// The take (.c3d, .trc or .csv).
+    pub file: PathBuf,
+    /// Where to send, HOST:PORT (e.g. the daemon's --listen address).
+    #[arg(long, value_name = "HOST:PORT")]
+    pub to: String,
+    /// Playback speed: 2 sends twice as fast (capture times stay in take time).
+    #[arg(long, default_value_t = 1.0)]
+    pub speed: f64,
+    /// After the last frame start again from the first, until Ctrl-C; frame numbers keep
+    /// increasing.
+    #[arg(long = "loop")]
+    pub looping: bool,
+    /// Index (0-based, whatever the file numbers it) of the first frame to send.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub start_frame: usize,
+    /// Layout id sent in /mocap/labels.
+    #[arg(long, default_value_t = 0, value_name = "ID")]
+    pub layout_id: i32,
+    /// Frame encoding: blob (`,ihbb`, with a missing-marker mask) or flat (`,ih` + floats, NaN
+    /// for missing).
+    #[arg(long, value_enum, default_value_t = WireFormat::Blob)]
+    pub format: WireFormat,
+    /// Overdue frames sent back to back after a stall; further behind, skip to the present.
+    #[arg(long, default_value_t = replay::pacer::DEFAULT_MAX_BEHIND_FRAMES, value_name = "FRAMES")]
+    pub max_behind: u64,
+}
+
+/// The `/mocap/frame` encoding of `emoshift replay`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum WireFormat {
+    /// `,ihbb`: frame, time, missing-marker mask blob, positions blob.
+    Blob,
+    /// `,ih` then 3 floats per marker, all NaN for a missing marker.
+    Flat,
+}
+
+/// `emoshift demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Keep everything the demo made in this folder (default: a temporary folder of which only
+    /// the report stays).
+    #[arg(long, value_name = "DIR")]
+    pub keep: Option<PathBuf>,
+    /// Run on the bundled real capture (Facial-Sing) instead of a synthetic session; there are
+    /// no emotion pairs, so there is no sweep.
+    #[arg(long)]
+    pub real: bool,
+    /// Seed of the synthetic session.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+}

@@ -1,0 +1,94 @@
+//! The command line: one clap-derive enum of subcommands, each a thin front end.
+
+use clap::{Parser, Subcommand};
+
+mod live;
+mod offline;
+
+pub use live::{BenchArgs, DemoArgs, ReplayArgs, ServeArgs, WireFormat};
+pub use offline::{
+    AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InspectArgs, KeyValue, ProjectArgs, SynthArgs,
+    TrainArgs,
+};
+
+/// emoshift: edit the emotion of facial motion capture, offline and live.
+#[derive(Debug, Parser)]
+#[command(name = "emoshift", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Write a synthetic paired session (takes, ground truth, session.toml, regions.toml).
+    #[command(after_help = "Examples:\n  emoshift synth --out session\n  \
+        emoshift synth --out s2 --seed 7 --sentences 4 --emotions neutral,sad,angry --format trc\n  \
+        emoshift synth --out s3 --emotion-dims 2 --emotions neutral,happy,sad,angry\n  \
+        emoshift synth --out s4 --emotions neutral,happy,calm --point calm=0.3,-0.4 --point happy=1,0.2\n\n\
+        Emotion space: each emotion is a point, one level per emotion direction (1: smile + / \
+        frown -, 2: brow knit + lip press, 3: inner brow raise + mouth corners down). Default \
+        points: k=1 neutral 0, happy 1, frustrated -1; k=2 neutral (0,0), happy (1,0), frustrated \
+        (-1,0.3), angry (-0.2,1), sad (-0.6,-0.8); k=3 the same with a third coordinate 0, except \
+        sad (-0.3,-0.2,1), plus surprised (0.2,-1,0) and fear (-0.3,0.6,0.9). Other names get \
+        spare points at least 0.5 from every other point. The truth (truth/mixing.json) records \
+        every point.")]
+    Synth(SynthArgs),
+    /// Show a take's labels, rate, frame range, units and missing samples per marker.
+    #[command(after_help = "Examples:\n  emoshift info take.c3d\n  emoshift info take.trc --json")]
+    Info(InfoArgs),
+    /// Convert a take between C3D, TRC and CSV (format chosen by extension; gaps kept).
+    #[command(after_help = "Examples:\n  emoshift convert Facial-Sing.c3d x.trc\n  \
+        emoshift convert x.trc y.c3d")]
+    Convert(ConvertArgs),
+    /// Learn an ICA model from takes.
+    #[command(
+        after_help = "Examples:\n  emoshift train --manifest session/session.toml --out model.json\n  \
+        emoshift train take1.c3d take2.c3d --out model.json --components 10 --restarts 8"
+    )]
+    Train(TrainArgs),
+    /// Project a take onto a model's components (CSV: frame,time,c0,...).
+    #[command(
+        after_help = "Example:\n  emoshift project --model model.json take.c3d --out components.csv"
+    )]
+    Project(ProjectArgs),
+    /// Edit a take in component space and write it in any format.
+    #[command(
+        after_help = "Examples:\n  emoshift edit --model model.json take.c3d --out edited.c3d --translate 2=1.5\n  \
+        emoshift edit --model model.json take.trc --out louder.trc --gain 0=1.3"
+    )]
+    Edit(EditArgs),
+    /// Show what a model holds.
+    #[command(
+        after_help = "Examples:\n  emoshift inspect model.json\n  emoshift inspect model.json --json"
+    )]
+    Inspect(InspectArgs),
+    /// Run the live service: receive frames, edit their emotion, send them to subscribers.
+    #[command(
+        after_help = "Examples:\n  emoshift serve --model model.json --send 127.0.0.1:9100\n  \
+        emoshift serve --config emoshift.toml --listen 127.0.0.1:9000 --send 239.0.0.1:9100:flat-split"
+    )]
+    Serve(ServeArgs),
+    /// Measure the service on loopback against a plain UDP relay: added latency, loss, throughput.
+    #[command(after_help = "Example:\n  emoshift bench --performers 2 --clients 4 --seconds 3")]
+    Bench(BenchArgs),
+    /// Label the components (emotion, speech, eyebrows, eyelids) and write the report.
+    #[command(
+        after_help = "Example:\n  emoshift analyze --model model.json --manifest session/session.toml --out report --write-model"
+    )]
+    Analyze(AnalyzeArgs),
+    /// Send a take over UDP at its rate, as a live source would (OSC /mocap/frame + labels).
+    #[command(
+        after_help = "Examples:\n  emoshift replay take.c3d --to 127.0.0.1:9000\n  \
+        emoshift replay take.trc --to 127.0.0.1:9000 --speed 2 --loop --start-frame 120"
+    )]
+    Replay(ReplayArgs),
+    /// Run the whole chain on an embedded default: synth, train, analyze, serve, replay with an
+    /// emotion sweep, receive, summarise.
+    #[command(
+        after_help = "Examples:\n  emoshift demo\n  emoshift demo --keep demo-out\n  emoshift demo --real"
+    )]
+    Demo(DemoArgs),
+}
