@@ -1,9 +1,40 @@
-//! The emoshift front ends and service.
+//! The `emoshift` binary's library: the frame engine, the offline logic, the live service, a
+//! loopback harness and the commands, over the leaf crates `ica-core` (numerics), `protocol`
+//! (wire formats) and `replay` (takes on disk, the synthetic face, the pacer).
 //!
-//! `main.rs` stays thin: it parses [`cli::Cli`] and calls [`exit::main_with`], which installs
-//! [`logging`], calls [`commands::run`] and maps the error to an exit code with
-//! [`exit::code_for`]. Each subcommand is a small function in [`commands`] over the library
-//! crates (`replay`, `ica-core`, `protocol`).
+//! # Rooms
+//!
+//! ```text
+//!                 ┌────────────┐
+//!   main.rs ────▶ │  commands  │  thin: parse arguments, call a room, print
+//!                 └──┬───┬───┬─┘
+//!                    │   │   └──────────────────┐
+//!                    ▼   ▼                      ▼
+//!          ┌──────────┐ ┌──────────┐ ────▶ ┌──────────┐
+//!          │ offline  │ │ loopback │       │  serve   │  tokio, sockets, threads, files
+//!          └────┬─────┘ └────┬─────┘       └────┬─────┘
+//!               │            │                  │
+//!               └────────────┴──────▶ ┌─────────▼──┐
+//!                                     │   engine   │  sans-IO: datagram + now → datagrams
+//!                                     └────────────┘
+//! ```
+//!
+//! Arrows point one way: nothing below knows what is above it.
+//!
+//! - [`engine`]: everything that turns a datagram into output datagrams and counters, without
+//!   tokio, sockets, clock or files (CI checks it). Its module docs walk a frame's path from
+//!   socket to socket.
+//! - [`offline`]: takes and models on disk, training preparation ([`offline::training`]),
+//!   analysis ([`offline::analysis`]) and edit planning ([`offline::edit`]), as functions over
+//!   takes and models. Numerics live in `ica-core`.
+//! - [`serve`]: the tokio runtime, the sockets, the control task, the processing thread, the
+//!   sender and the recordings, around one engine [`engine::Pipeline`].
+//! - [`loopback`]: one in-process harness (daemon, paced source, receiver, control client,
+//!   synthetic models) for the demo, `emoshift bench` and the end-to-end tests.
+//! - [`commands`]: one small module per subcommand; [`cli`] is their arguments.
+//!
+//! `main.rs` parses [`cli::Cli`] and calls [`commands::main_with`], which installs
+//! [`logging`], runs the command and maps its error to an exit code ([`exit::code_for`]).
 #![warn(missing_docs)]
 
 pub mod cli;

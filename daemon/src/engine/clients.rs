@@ -7,7 +7,7 @@
 //! Call order: [`Clients::handle_control`] per control message, [`Clients::handle_send`] per
 //! send result, [`Clients::poll_expired`] now and then. The caller owns sockets and clock.
 
-use std::net::SocketAddr;
+use core::net::SocketAddr;
 use std::time::{Duration, Instant};
 
 use protocol::{Control, Profile};

@@ -1,26 +1,42 @@
 //! The frame engine: a datagram and the caller's `now` in, output datagrams and counters out.
-//! Sans-IO: no tokio, no sockets, no clock, no files (CI checks it); the [`crate::serve`]
-//! shell owns all of those.
+//! Sans-IO: no tokio, no sockets, no clock, no files (`scripts/check-engine` checks it in
+//! CI); the [`crate::serve`] shell owns all of those.
 //!
-//! # A frame's path
+//! # A frame's path, socket to socket
 //!
-//! [`Pipeline::handle_datagram`] (source address, bytes):
+//! In the shell (`serve`):
 //!
-//! 1. **Scan** the datagram ([`protocol::messages`]): bundles flattened, limits enforced; a bad
-//!    packet is counted by kind and dropped.
-//! 2. **Labels** (`/mocap/labels`) update the source's layouts ([`protocol::LayoutBook`]).
-//! 3. **Frame** (`/mocap/frame`): decoded into a reusable [`protocol::FrameBuf`]; its layout is
-//!    the source's latest labels of the same marker count; frames without one are counted.
-//! 4. **Stream**: the (source, layout) pair's [`Stream`] is found or created (its model, its
-//!    performer, its [`LabelMap`] from the source's labels to the model's markers).
+//! 1. The receive task reads the datagram off the frame socket into a pooled buffer and
+//!    queues it for the processing thread (a full queue drops the oldest, counted).
+//! 2. The processing thread takes it off the queue between commands and hands it to
+//!    [`Pipeline::handle_datagram`].
+//!
+//! In the engine:
+//!
+//! 3. [`Pipeline::handle_datagram`] **scans** the datagram ([`protocol::messages`]): bundles
+//!    flattened, limits enforced; a bad packet is counted by kind and dropped. Labels
+//!    (`/mocap/labels`) update the source's layouts ([`protocol::LayoutBook`]).
+//! 4. `Pipeline::handle_frame` **decodes** `/mocap/frame` into a reusable
+//!    [`protocol::FrameBuf`], finds its layout (the source's latest labels of the same marker
+//!    count) and its [`Stream`] (made on the first frame: its model, its performer, its
+//!    [`LabelMap`]).
 //! 5. [`Stream::process`]: frame order checked (duplicates and stale frames dropped, a restart
-//!    noticed); markers gathered into model order; [`FrameProcessor`] prepares (glitch checks,
-//!    head stabilisation), projects (masked where markers are missing), the [`EditState`]
-//!    edits the components, the processor resynthesises and puts the head pose back.
-//! 6. **Encode** once per wanted profile ([`pipeline`]): compact, flat-split, components.
-//! 7. **Emit**: the encoded bytes go to the caller's sink ([`Emitted`]), once per frame.
+//!    noticed); markers gathered into model order; the [`FrameProcessor`] prepares (glitch
+//!    checks, head stabilisation) and projects (masked where markers are missing); the
+//!    [`EditState`] edits the components; the processor resynthesises and puts the head pose
+//!    back.
+//! 6. The pipeline's outputs **encode** the frame once per profile a subscriber wants
+//!    (compact, flat-split, components; `pipeline::encode`).
+//! 7. The caller's `emit` gets the encoded bytes ([`Emitted`]), once per frame.
 //!
-//! Control reaches the engine between frames as [`Command`]s ([`Pipeline::handle_command`]).
+//! Back in the shell:
+//!
+//! 8. `emit` sends the bytes to every subscriber of that profile from the processing thread
+//!    (`serve::sender::Fanout`), then hands the frame to the recording, if one runs.
+//!
+//! Edits and model swaps reach the engine between two datagrams, so no frame sees half a
+//! change ([`Pipeline::handle_edit`], [`Pipeline::set_model`]). Who is subscribed, and until
+//! when, is [`clients`]; the shell asks it with its own `now`.
 
 pub mod clients;
 mod counters;
@@ -28,6 +44,7 @@ pub mod edit_state;
 pub mod frame;
 pub mod layout;
 pub mod pipeline;
+pub mod stream;
 pub mod streams;
 
 pub use counters::Counters;
@@ -35,4 +52,5 @@ pub use edit_state::EditState;
 pub use frame::{FramePrep, FrameProcessor, Prepared};
 pub use layout::LabelMap;
 pub use pipeline::{Emitted, Pipeline, PipelineConfig};
-pub use streams::{Performer, Stream, StreamStatus};
+pub use stream::Stream;
+pub use streams::{Performer, PerformerConfig, StreamKey, StreamStatus};

@@ -9,6 +9,8 @@ use std::time::Duration;
 use protocol::Profile;
 use serde::Deserialize;
 
+pub use crate::engine::PerformerConfig;
+
 /// Default frame port.
 pub const DEFAULT_LISTEN: &str = "127.0.0.1:9000";
 /// Default control port.
@@ -65,23 +67,6 @@ pub struct RawConfig {
     pub stats_interval_s: Option<f64>,
     /// Named performers.
     pub performers: Vec<RawPerformer>,
-}
-
-/// A validated performer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PerformerConfig {
-    /// Name.
-    pub name: String,
-    /// Model file.
-    pub model: Option<PathBuf>,
-    /// Sender address.
-    pub source: Option<SocketAddr>,
-    /// Layout id.
-    pub layout: Option<i32>,
-    /// Default emotion.
-    pub emotion: Option<String>,
-    /// Default amount.
-    pub amount: Option<f32>,
 }
 
 /// The validated configuration; the only form that travels on.
@@ -225,7 +210,7 @@ impl RawConfig {
                     model: p.model,
                     source,
                     layout: p.layout,
-                    emotion: p.emotion,
+                    target: p.emotion,
                     amount: p.amount,
                 })
             })

@@ -1,18 +1,18 @@
-//! `emoshift serve`: the live service.
+//! `emoshift serve`: the live service, the shell around one [`crate::engine::Pipeline`]. It
+//! owns what the engine may not: the tokio runtime, sockets, threads, the clock and files.
 //!
 //! - [`config`]: TOML + CLI → one validated [`Config`];
-//! - [`pipeline`]: the sans-IO frame path (decode → map labels → project → edit → resynthesise
-//!   → encode), owning every buffer;
-//! - [`edit_state`]: the live emotion edit (target, amount, ramp, low-pass, alpha, gains,
-//!   bypass) on a frame clock;
-//! - [`streams`]: one stream per source address and layout id, performers;
-//! - [`clients`]: subscribers, sans-IO; [`stats`]: counters and histograms;
-//! - [`record`]: recordings; [`synthetic`]: models and frames for bench and tests;
+//! - `server`: binds the sockets and runs the tasks (the receive task, the control task, the
+//!   status log, signals); the only code that awaits, with `control`;
+//! - `control`: control datagrams → [`command`](self) requests to the processing thread, and
+//!   the replies;
+//! - `processing`: the processing thread: frames through the engine, commands between
+//!   frames, the recording, counters merged into [`stats`];
+//! - `sender`: the processing thread's fan-out to the subscribers;
 //! - [`arrival`]: when the processing thread polls instead of parking (a steady source's
 //!   beat);
-//! - [`net`]: sockets (large receive buffers, connected senders);
-//! - `server`, `control`: the tasks, the only code that awaits; `processing`: the processing
-//!   thread; `sender`: its fan-out to the subscribers.
+//! - [`record`]: recordings of the edited stream and the raw input;
+//! - [`net`]: sockets (large receive buffers, connected senders).
 //!
 //! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
 //! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).

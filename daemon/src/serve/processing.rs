@@ -47,6 +47,26 @@ pub(crate) struct Channels {
     pub(crate) commands: Receiver<Request>,
 }
 
+/// What the processing thread shares with the rest of the service.
+pub(crate) struct Shared {
+    /// Counters for `/status` and the log, merged in between bursts.
+    pub(crate) stats: Arc<Mutex<Stats>>,
+    /// Frames the receive task dropped because the queue was full.
+    pub(crate) queue_dropped: Arc<AtomicU64>,
+}
+
+/// What the processing thread does while its queue is empty.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Next {
+    /// Wait up to this long for a frame or a command; a timeout means nothing came for a
+    /// while, a good moment to tidy.
+    WaitIdle(Duration),
+    /// Wait up to this long: a planned wake-up before the next beat, nothing to tidy.
+    WaitBeat(Duration),
+    /// The counters were merged in the gap before the next tick; plan again.
+    PlanAgain,
+}
+
 /// The processing thread's state.
 pub(crate) struct Processing {
     pipeline: Pipeline,
@@ -74,7 +94,7 @@ impl Processing {
         fanout: Fanout,
         poll_window: Duration,
         channels: Channels,
-        (stats, queue_dropped): (Arc<Mutex<Stats>>, Arc<AtomicU64>),
+        shared: Shared,
     ) -> Processing {
         let mut processing = Processing {
             pipeline,
@@ -88,8 +108,8 @@ impl Processing {
             frame_rx: channels.frames,
             free_tx: channels.free,
             cmd_rx: channels.commands,
-            stats,
-            queue_dropped,
+            stats: shared.stats,
+            queue_dropped: shared.queue_dropped,
             recording: None,
             closing: Vec::new(),
             last_merge: Instant::now(),
@@ -102,10 +122,10 @@ impl Processing {
     /// Runs until the receive task closes the queue, then closes the recording.
     pub(crate) fn run(mut self) {
         loop {
-            // `idle`: the timeout means nothing came for a while (not a planned wake-up before
-            // the next beat), a good moment for the counters.
-            let Some((timeout, idle)) = self.plan_wait() else {
-                continue;
+            let (timeout, idle) = match self.plan_wait() {
+                Next::WaitIdle(t) => (t, true),
+                Next::WaitBeat(t) => (t, false),
+                Next::PlanAgain => continue,
             };
             crossbeam_channel::select! {
                 recv(self.frame_rx) -> msg => match msg {
@@ -130,12 +150,10 @@ impl Processing {
         }
     }
 
-    /// How long to wait for the next frame or command, and whether that wait means idle;
-    /// `None` when it merged the counters instead (in the gap before the next tick), so the
-    /// caller plans again.
-    fn plan_wait(&mut self) -> Option<(Duration, bool)> {
+    /// How long to wait for the next frame or command (polling first when a beat is due).
+    fn plan_wait(&mut self) -> Next {
         if !self.frame_rx.is_empty() {
-            return Some((Duration::ZERO, false));
+            return Next::WaitBeat(Duration::ZERO);
         }
         let now = Instant::now();
         match self.arrival.plan(now) {
@@ -145,21 +163,21 @@ impl Processing {
                 } else {
                     self.poll_misses += 1;
                 }
-                Some((IDLE, true))
+                Next::WaitIdle(IDLE)
             }
             Wait::ParkUntil(at) => {
                 let due = self.last_merge.elapsed() >= MERGE_EVERY && at - now > QUIET;
                 match self.arrival.burst_end() {
                     // Merge in the gap, once this tick's frames are all in.
-                    Some(end) if due && end > now => Some(((end - now).min(at - now), false)),
+                    Some(end) if due && end > now => Next::WaitBeat((end - now).min(at - now)),
                     _ if due && self.cmd_rx.is_empty() => {
                         self.tidy();
-                        None
+                        Next::PlanAgain
                     }
-                    _ => Some(((at - now).min(IDLE), false)),
+                    _ => Next::WaitBeat((at - now).min(IDLE)),
                 }
             }
-            Wait::Park => Some((IDLE, true)),
+            Wait::Park => Next::WaitIdle(IDLE),
         }
     }
 

@@ -25,7 +25,7 @@ use tokio_util::task::TaskTracker;
 
 use super::command::Request;
 use super::control::{self, ControlCtx};
-use super::processing::{Channels, InFrame, Processing};
+use super::processing::{Channels, InFrame, Processing, Shared};
 use super::sender::Fanout;
 use super::stats::Stats;
 use super::Config;
@@ -62,19 +62,12 @@ pub async fn bind(config: Config) -> Result<Bound> {
 pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
     let model = Arc::new(model);
     let mut performers = Vec::with_capacity(config.performers.len());
-    for p in &config.performers {
+    for p in config.performers.iter().cloned() {
         let model = match &p.model {
             Some(path) => Some(Arc::new(super::load_model(path.clone()).await?)),
             None => None,
         };
-        performers.push(Performer {
-            name: p.name.clone(),
-            source: p.source,
-            layout: p.layout,
-            model,
-            target: p.emotion.clone(),
-            amount: p.amount,
-        });
+        performers.push(p.with_model(model));
     }
     let frames = super::net::bind_receiver(config.listen)
         .with_context(|| format!("binding the frame socket {}", config.listen))?;
@@ -137,7 +130,10 @@ impl Bound {
                 free: free_tx,
                 commands: cmd_rx,
             },
-            (Arc::clone(&stats), Arc::clone(&queue_dropped)),
+            Shared {
+                stats: Arc::clone(&stats),
+                queue_dropped: Arc::clone(&queue_dropped),
+            },
         );
         let processing = tracker.spawn_blocking(move || processing.run());
 

@@ -91,7 +91,7 @@ pub(crate) struct IcaRun {
     pub restart_w: Vec<DMatrix<f64>>,
 }
 
-/// Restarts explore about this many frames when the take is long enough (see [`run`]).
+/// Restarts explore about this many frames when the take is long enough (see `run`).
 pub const EXPLORE_FRAMES: usize = 2500;
 
 /// Column stride of the exploration subsample: 1 (no subsample) for a single restart or a take

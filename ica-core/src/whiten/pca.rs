@@ -268,9 +268,9 @@ mod tests {
     use crate::mixture;
     use crate::whiten::{whiten, Components};
 
-    /// Issue 18: the PCA axes' signs follow the data, not the eigen-solver's rounding.
+    /// The PCA axes' signs follow the data, not the eigen-solver's rounding.
     #[test]
-    fn issue_18_one_ulp_does_not_flip_an_axis() {
+    fn one_ulp_does_not_flip_an_axis() {
         let mix = mixture::face_like(4_000, 60, 6, 0.2, 3);
         let data = FitData::new(&mix.samples, 60).expect("whole frames");
         let a = whiten(&data, Components::Fixed(6)).expect("whitens");

@@ -1,6 +1,10 @@
 //! Encoding a processed frame once per profile the subscribers want.
 
-use protocol::{encode_compact_into, encode_components_into, FlatSplit, FrameBuf, Profile};
+use protocol::{
+    encode_compact_into, encode_components_into, FlatSplit, FrameBuf, Profile, ETHERNET_PAYLOAD,
+};
+
+use crate::engine::edit_state::EditState;
 
 /// Profiles to encode, as a bit set (`1 << profile index` in [`Profile::ALL`]).
 pub type ProfileMask = u8;
@@ -14,32 +18,62 @@ pub fn profile_bit(p: Profile) -> ProfileMask {
     }
 }
 
-/// Encodes the wanted profiles of one frame into the pipeline's buffers.
-pub(super) fn encode(
-    wanted: ProfileMask,
-    frame: &FrameBuf,
-    edit: &crate::engine::edit_state::EditState,
-    (u, vmc): (&[f32], &[(String, usize)]),
-    split: &FlatSplit,
-    [compact, components, part, parts]: [&mut Vec<u8>; 4],
-    part_ends: &mut Vec<usize>,
-) -> Result<(), protocol::EncodeError> {
-    compact.clear();
-    components.clear();
-    parts.clear();
-    part_ends.clear();
-    if wanted & profile_bit(Profile::Compact) != 0 {
-        encode_compact_into(frame, edit.target(), edit.amount(), compact)?;
-    }
-    if wanted & profile_bit(Profile::Components) != 0 {
-        encode_components_into(u, vmc, components)?;
-    }
-    if wanted & profile_bit(Profile::FlatSplit) != 0 {
-        for i in 0..split.part_count(frame.marker_count()) {
-            split.encode_part_into(frame, i, part);
-            parts.extend_from_slice(part);
-            part_ends.push(parts.len());
+/// The encoded output of one frame, one buffer per profile, reused frame after frame.
+#[derive(Debug)]
+pub(super) struct Outputs {
+    split: FlatSplit,
+    /// Compact bundle (empty when not wanted).
+    pub(super) compact: Vec<u8>,
+    /// Components message (empty when not wanted).
+    pub(super) components: Vec<u8>,
+    /// One flat-split part, encoded before it is appended to `parts`.
+    part: Vec<u8>,
+    /// Flat-split parts, concatenated.
+    pub(super) parts: Vec<u8>,
+    /// End offset of each part in `parts`.
+    pub(super) part_ends: Vec<usize>,
+}
+
+impl Outputs {
+    /// Buffers for frames of up to `max_markers` markers.
+    pub(super) fn new(max_markers: usize) -> Outputs {
+        Outputs {
+            split: FlatSplit::new(ETHERNET_PAYLOAD).expect("an Ethernet payload holds a marker"),
+            compact: Vec::with_capacity(ETHERNET_PAYLOAD),
+            components: Vec::with_capacity(ETHERNET_PAYLOAD),
+            part: Vec::with_capacity(ETHERNET_PAYLOAD),
+            parts: Vec::with_capacity(16 * max_markers + 4 * ETHERNET_PAYLOAD),
+            part_ends: Vec::with_capacity(max_markers),
         }
     }
-    Ok(())
+
+    /// Encodes `frame` once for each profile in `wanted`, with the stream's edit state (for
+    /// the compact state message), its components `u` and their VMC names.
+    pub(super) fn encode(
+        &mut self,
+        wanted: ProfileMask,
+        frame: &FrameBuf,
+        edit: &EditState,
+        u: &[f32],
+        vmc: &[(String, usize)],
+    ) -> Result<(), protocol::EncodeError> {
+        self.compact.clear();
+        self.components.clear();
+        self.parts.clear();
+        self.part_ends.clear();
+        if wanted & profile_bit(Profile::Compact) != 0 {
+            encode_compact_into(frame, edit.target(), edit.amount(), &mut self.compact)?;
+        }
+        if wanted & profile_bit(Profile::Components) != 0 {
+            encode_components_into(u, vmc, &mut self.components)?;
+        }
+        if wanted & profile_bit(Profile::FlatSplit) != 0 {
+            for i in 0..self.split.part_count(frame.marker_count()) {
+                self.split.encode_part_into(frame, i, &mut self.part);
+                self.parts.extend_from_slice(&self.part);
+                self.part_ends.push(self.parts.len());
+            }
+        }
+        Ok(())
+    }
 }

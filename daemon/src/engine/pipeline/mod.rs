@@ -1,32 +1,30 @@
-//! The processing path, sans-IO: datagram → decode → map labels → [`FrameProcessor`] (glitch
-//! check, head stabilisation, masked projection) → live edit → resynthesis → encode once per
-//! wanted profile. It owns every buffer (sized at construction and per stream at stream
-//! creation), builds without tokio and is tested without a runtime.
+//! The [`Pipeline`]: the engine's one entry point (the path is drawn in [`crate::engine`]). It
+//! owns every buffer (sized at construction, and per stream when the stream is made).
 //!
 //! Call order: [`Pipeline::handle_datagram`] per received datagram, which calls `emit` once
 //! per processed frame with the encoded bytes; [`Pipeline::handle_edit`] and
 //! [`Pipeline::set_model`] between datagrams (a frame boundary).
 
-use std::net::SocketAddr;
+use core::net::SocketAddr;
 use std::sync::Arc;
 
 use ica_core::model::IcaModel;
 use protocol::{
-    decode_frame_into, decode_labels, messages, Address, Control, FlatSplit, FrameBuf, LayoutBook,
-    LayoutChange, Limits, Profile, ETHERNET_PAYLOAD,
+    decode_frame_into, decode_labels, messages, Address, Control, FrameBuf, LayoutBook,
+    LayoutChange, Limits, Profile,
 };
 
-use crate::engine::edit_state::EditRefused;
-use crate::engine::streams::{Order, Performer, Stream, StreamKey, Streams};
+use crate::engine::edit_state::{EditRefused, EditState};
+use crate::engine::streams::{Performer, StreamKey, StreamStatus, Streams};
 use crate::engine::Counters;
 
 mod encode;
 mod setup;
 
-use encode::encode;
+use encode::Outputs;
 pub use encode::{profile_bit, ProfileMask};
 pub use setup::apply_edit;
-use setup::{new_stream, source_labels};
+use setup::new_stream;
 
 /// Sources tracked for labels, and streams, at most (bounds memory against spoofed senders).
 pub const MAX_SOURCES: usize = 64;
@@ -88,16 +86,11 @@ pub struct Pipeline {
     layouts: LayoutBook<SocketAddr>,
     streams: Streams,
     /// Settings of the default model's streams, copied into new streams.
-    template: crate::engine::edit_state::EditState,
+    template: EditState,
     limits: Limits,
     frame_in: FrameBuf,
     frame_out: FrameBuf,
-    split: FlatSplit,
-    compact: Vec<u8>,
-    components: Vec<u8>,
-    part: Vec<u8>,
-    parts: Vec<u8>,
-    part_ends: Vec<usize>,
+    outputs: Outputs,
     wanted: ProfileMask,
     /// Counters, read by the caller after each batch.
     pub counters: Counters,
@@ -106,19 +99,14 @@ pub struct Pipeline {
 impl Pipeline {
     /// A pipeline over `model`, with optional named performers.
     pub fn new(model: Arc<IcaModel>, performers: Vec<Performer>, config: PipelineConfig) -> Self {
-        let template = crate::engine::edit_state::EditState::for_model(&model, config.lowpass_s);
+        let template = EditState::for_model(&model, config.lowpass_s);
         Pipeline {
             layouts: LayoutBook::new(MAX_SOURCES),
             streams: Streams::new(MAX_SOURCES),
             limits: Limits::default(),
             frame_in: FrameBuf::with_max_markers(config.max_markers),
             frame_out: FrameBuf::with_max_markers(config.max_markers),
-            split: FlatSplit::new(ETHERNET_PAYLOAD).expect("an Ethernet payload holds a marker"),
-            compact: Vec::with_capacity(ETHERNET_PAYLOAD),
-            components: Vec::with_capacity(ETHERNET_PAYLOAD),
-            part: Vec::with_capacity(ETHERNET_PAYLOAD),
-            parts: Vec::with_capacity(16 * config.max_markers + 4 * ETHERNET_PAYLOAD),
-            part_ends: Vec::with_capacity(config.max_markers),
+            outputs: Outputs::new(config.max_markers),
             wanted: profile_bit(Profile::Compact),
             counters: Counters::default(),
             template,
@@ -133,43 +121,29 @@ impl Pipeline {
         self.wanted = wanted;
     }
 
-    /// The loaded model.
-    pub fn model(&self) -> &Arc<IcaModel> {
-        &self.model
-    }
-
     /// Streams now.
     pub fn stream_count(&self) -> usize {
         self.streams.len()
     }
 
     /// Each stream's counters.
-    pub fn stream_status(&self) -> Vec<crate::engine::streams::StreamStatus> {
+    pub fn stream_status(&self) -> Vec<StreamStatus> {
         self.streams.status(&self.performers)
     }
 
     /// Swaps in a new default model at a frame boundary: streams on the default model are
     /// rebuilt on it, keeping their edit settings; no frame is dropped.
     pub fn set_model(&mut self, model: Arc<IcaModel>) {
-        let mut template =
-            crate::engine::edit_state::EditState::for_model(&model, self.config.lowpass_s);
+        let mut template = EditState::for_model(&model, self.config.lowpass_s);
         template.copy_settings(&self.template);
         self.template = template;
-        let old = Arc::clone(&self.model);
-        self.model = model;
+        let old = std::mem::replace(&mut self.model, model);
         for (_, stream) in self.streams.iter_mut() {
             if !Arc::ptr_eq(&stream.model, &old) {
                 continue;
             }
-            let labels = source_labels(&stream.map, old.labels());
-            if let Ok(mut fresh) = Stream::new(
-                Arc::clone(&self.model),
-                stream.performer,
-                &labels,
-                self.config.lowpass_s,
-            ) {
-                fresh.edit.copy_settings(&stream.edit);
-                fresh.take_last_frame_from(stream);
+            // A stream whose labels share nothing with the new model keeps the old one.
+            if let Ok(fresh) = stream.rebuilt_on(Arc::clone(&self.model), self.config.lowpass_s) {
                 *stream = fresh;
             }
         }
@@ -231,14 +205,17 @@ impl Pipeline {
         }
     }
 
+    /// Steps 3 to 7 of the frame's path: decode, layout, stream, [`Stream::process`],
+    /// encode, emit.
+    ///
+    /// [`Stream::process`]: crate::engine::Stream::process
     fn handle_frame(&mut self, peer: SocketAddr, bytes: &[u8], emit: &mut dyn FnMut(&Emitted<'_>)) {
         let header = match decode_frame_into(bytes, &mut self.frame_in) {
             Ok(h) => h,
             Err(e) => return self.counters.bad_packet(e.kind()),
         };
         self.counters.frames_in += 1;
-        // One lookup of the layout and one of the stream per frame (each a SipHash of the
-        // address): the labels found here also go out with the frame.
+        // The labels found here also go out with the frame (to the raw recording).
         let Some(labels) = self.layouts.layout_for(&peer, header.marker_count) else {
             return self.counters.dropped_no_layout += 1;
         };
@@ -260,87 +237,34 @@ impl Pipeline {
         }) else {
             return self.counters.dropped_unmatched += 1;
         };
-        let frames = match stream.check_order(header.frame_number) {
-            Order::Next { frames } => frames,
-            Order::Restart => {
-                self.counters.restarts += 1;
-                1
-            }
-            Order::Duplicate => return self.counters.dropped_duplicate += 1,
-            Order::Stale => return self.counters.dropped_stale += 1,
+        let counters = &mut self.counters;
+        let Some(frames) = stream.process(&header, &self.frame_in, &mut self.frame_out, counters)
+        else {
+            return;
         };
-        let Stream {
-            map,
-            processor,
-            edit,
-            xyz,
-            missing,
-            u,
-            out,
-            take_missing,
-            model,
-            vmc,
-            ..
-        } = stream;
-        if header.missing_count == 0 {
-            map.gather_present_into(self.frame_in.positions(), xyz, missing);
-        } else {
-            for (i, m) in take_missing.iter_mut().enumerate() {
-                *m = self.frame_in.is_missing(i);
-            }
-            map.gather_into(self.frame_in.positions(), take_missing, xyz, missing);
-        }
-        self.counters.missing_markers += missing.iter().filter(|&&m| m).count() as u64;
-        let prepared = match processor.project(xyz, missing, u) {
-            Ok(p) => p,
-            Err(_) => return self.counters.frame_errors += 1,
-        };
-        self.counters.glitches += prepared.glitches as u64;
-        let rate = model.rate_hz();
-        let dt = (f64::from(frames.min(rate.max(1.0) as u32)) / rate) as f32;
-        edit.apply(dt, u);
-        if processor
-            .resynthesise(prepared.pose.as_ref(), u, out)
-            .is_err()
-            || self
-                .frame_out
-                .set_frame(header.frame_number, header.capture_time_us, out)
-                .is_err()
-        {
-            return self.counters.frame_errors += 1;
-        }
-        if encode(
-            self.wanted,
-            &self.frame_out,
-            edit,
-            (u, vmc),
-            &self.split,
-            [
-                &mut self.compact,
-                &mut self.components,
-                &mut self.part,
-                &mut self.parts,
-            ],
-            &mut self.part_ends,
-        )
+        let (edit, u, vmc) = (&stream.edit, stream.components(), &stream.vmc);
+        if (self
+            .outputs
+            .encode(self.wanted, &self.frame_out, edit, u, vmc))
         .is_err()
         {
             return self.counters.frame_errors += 1;
         }
         self.counters.frames_out += 1;
+        let out = &self.outputs;
         emit(&Emitted {
             key,
             frame_number: header.frame_number,
             frames_since_last: frames,
-            compact: &self.compact,
-            parts: &self.parts,
-            part_ends: &self.part_ends,
-            components: &self.components,
-            xyz: out,
+            compact: &out.compact,
+            parts: &out.parts,
+            part_ends: &out.part_ends,
+            components: &out.components,
+            xyz: stream.edited(),
             input: &self.frame_in,
             input_labels: &labels.names,
-            labels: model.labels(),
-            rate_hz: rate,
+            labels: stream.model.labels(),
+            rate_hz: stream.model.rate_hz(),
         });
     }
 }

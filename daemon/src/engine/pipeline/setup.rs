@@ -6,7 +6,8 @@ use ica_core::model::IcaModel;
 use protocol::Control;
 
 use crate::engine::edit_state::EditRefused;
-use crate::engine::streams::{Performer, Stream, StreamKey};
+use crate::engine::stream::Stream;
+use crate::engine::streams::{Performer, StreamKey};
 
 /// A new stream for `key` on its performer's model (or the default one, with the template's
 /// edit settings); `None` when its labels share none with the model.
@@ -49,28 +50,6 @@ fn defaults_of(p: &Performer, stream: &mut Stream) {
     stream
         .edit
         .set_ramp(crate::engine::edit_state::DEFAULT_RAMP_S);
-}
-
-/// The stream's source labels, rebuilt from its map for a model swap (unmapped source markers
-/// get placeholder names that match nothing).
-pub(super) fn source_labels(
-    map: &crate::engine::layout::LabelMap,
-    model_labels: &[String],
-) -> Vec<String> {
-    let n = map
-        .model_to_take
-        .iter()
-        .flatten()
-        .chain(map.extra.iter())
-        .max()
-        .map_or(0, |m| m + 1);
-    let mut labels: Vec<String> = (0..n).map(|i| format!("\u{0}unmapped{i}")).collect();
-    for (i, t) in map.model_to_take.iter().enumerate() {
-        if let Some(t) = t {
-            labels[*t] = model_labels[i].clone();
-        }
-    }
-    labels
 }
 
 /// A blend's name as the state reports it: `sad:0.50,angry:0.50` (weights normalised).
