@@ -15,6 +15,12 @@ use std::time::Duration;
 use protocol::*;
 use rosc::{OscMessage, OscPacket, OscType};
 
+/// The stream the example's outputs name.
+const TAG: StreamTag<'static> = StreamTag {
+    id: 0,
+    name: "osc_peer",
+};
+
 type Res<T> = Result<T, String>;
 
 fn main() {
@@ -88,7 +94,9 @@ fn send_frame(addr: &str, rest: &[String]) -> Res<()> {
             .map_err(|_| format!("--parts: cannot parse {max:?}"))?;
         let split = FlatSplit::new(max).map_err(|e| e.to_string())?;
         for p in 0..split.part_count(frame.marker_count()) {
-            split.encode_part_into(&frame, p, &mut out);
+            split
+                .encode_part_into(&TAG, &frame, p, &mut out)
+                .map_err(|e| e.to_string())?;
             send(&s, &out)?;
         }
         return Ok(());
@@ -100,7 +108,7 @@ fn send_frame(addr: &str, rest: &[String]) -> Res<()> {
         let amount = amount
             .parse()
             .map_err(|_| format!("bad amount {amount:?}"))?;
-        encode_compact_into(&frame, target, amount, &mut out).map_err(|e| e.to_string())?;
+        encode_compact_into(&TAG, &frame, target, amount, &mut out).map_err(|e| e.to_string())?;
     } else if rest.iter().any(|a| a == "--flat") {
         encode_frame_flat_into(&frame, &mut out).map_err(|e| e.to_string())?;
     } else {
@@ -124,7 +132,7 @@ fn send_components(addr: &str, rest: &[String]) -> Res<()> {
         ));
     }
     let mut out = Vec::new();
-    encode_components_into(&u, &vmc, &mut out).map_err(|e| e.to_string())?;
+    encode_components_into(&TAG, &u, &vmc, &mut out).map_err(|e| e.to_string())?;
     send(&socket(addr)?, &out)
 }
 

@@ -14,6 +14,10 @@ pub const COMPONENTS: &str = "/emoshift/components";
 pub const VMC_BLEND_VAL: &str = "/VMC/Ext/Blend/Val";
 /// VMC "apply the values sent so far", no arguments.
 pub const VMC_BLEND_APPLY: &str = "/VMC/Ext/Blend/Apply";
+/// The stream an output bundle belongs to, `,is` (stream id, name); first in the bundle.
+pub const STREAM: &str = "/emoshift/stream";
+/// The cookie a subscription from beyond loopback must echo, `,i`.
+pub const SUBSCRIBE_CHALLENGE: &str = "/subscribe/challenge";
 /// Error reply to a control message, `,ss` (address, message).
 pub const ERROR: &str = "/emoshift/error";
 /// Suffix appended to a control address for its success reply.
@@ -60,6 +64,10 @@ pub enum Address {
     Part,
     /// [`STATE`]
     State,
+    /// [`STREAM`]
+    Stream,
+    /// [`SUBSCRIBE_CHALLENGE`]
+    Challenge,
     /// [`COMPONENTS`]
     Components,
     /// [`VMC_BLEND_VAL`]
@@ -99,6 +107,8 @@ impl Address {
             LABELS => Address::Labels,
             PART => Address::Part,
             STATE => Address::State,
+            STREAM => Address::Stream,
+            SUBSCRIBE_CHALLENGE => Address::Challenge,
             COMPONENTS => Address::Components,
             VMC_BLEND_VAL => Address::VmcBlendVal,
             VMC_BLEND_APPLY => Address::VmcBlendApply,

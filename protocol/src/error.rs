@@ -111,9 +111,15 @@ pub enum DecodeError {
         /// Offset of the string.
         offset: usize,
     },
-    /// A value is out of its allowed range (negative count, empty or duplicate label, ...).
+    /// A value is out of its allowed range (negative count, empty label, ...).
     #[error("value at argument {index} is out of range")]
     OutOfRange {
+        /// Argument index in the message.
+        index: usize,
+    },
+    /// A `/mocap/labels` names a marker twice: no frame could say which is which.
+    #[error("label at argument {index} repeats an earlier one")]
+    DuplicateLabel {
         /// Argument index in the message.
         index: usize,
     },
@@ -141,11 +147,12 @@ pub enum DecodeErrorKind {
     BadElementSize,
     BadString,
     OutOfRange,
+    DuplicateLabel,
 }
 
 impl DecodeErrorKind {
     /// Every kind, in declaration order: `ALL[k.index()] == k`.
-    pub const ALL: [DecodeErrorKind; 18] = [
+    pub const ALL: [DecodeErrorKind; 19] = [
         Self::Empty,
         Self::Oversize,
         Self::Truncated,
@@ -164,6 +171,7 @@ impl DecodeErrorKind {
         Self::BadElementSize,
         Self::BadString,
         Self::OutOfRange,
+        Self::DuplicateLabel,
     ];
 
     /// Dense index for an array of counters (`[u64; DecodeErrorKind::ALL.len()]`).
@@ -192,6 +200,7 @@ impl DecodeErrorKind {
             Self::BadElementSize => "bad_element_size",
             Self::BadString => "bad_string",
             Self::OutOfRange => "out_of_range",
+            Self::DuplicateLabel => "duplicate_label",
         }
     }
 }
@@ -219,6 +228,7 @@ impl DecodeError {
             Self::BadElementSize { .. } => K::BadElementSize,
             Self::BadString { .. } => K::BadString,
             Self::OutOfRange { .. } => K::OutOfRange,
+            Self::DuplicateLabel { .. } => K::DuplicateLabel,
         }
     }
 }
@@ -243,6 +253,14 @@ pub enum EncodeError {
     /// A string contains a NUL byte, which OSC strings cannot carry.
     #[error("string contains a nul byte")]
     NulInString,
+    /// A stream name longer than [`crate::MAX_STREAM_NAME_BYTES`].
+    #[error("stream name of {len} bytes exceeds {max}")]
+    NameTooLong {
+        /// Its length.
+        len: usize,
+        /// The limit.
+        max: usize,
+    },
     /// The split size leaves no room for even one marker per part.
     #[error("a part of at most {max} bytes cannot hold one marker")]
     PartTooSmall {

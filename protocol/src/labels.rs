@@ -39,8 +39,11 @@ pub fn decode_labels(msg: &[u8]) -> Result<Labels, DecodeError> {
         let OscType::String(name) = a else {
             return Err(DecodeError::WrongTypeTags);
         };
-        if name.is_empty() || names.contains(&name) {
+        if name.is_empty() {
             return Err(DecodeError::OutOfRange { index: i + 1 });
+        }
+        if names.contains(&name) {
+            return Err(DecodeError::DuplicateLabel { index: i + 1 });
         }
         names.push(name);
     }
@@ -231,7 +234,7 @@ mod tests {
         encode_labels_into(&labels(3, &["a", "a"]), &mut out).expect("no nul");
         assert_eq!(
             decode_labels(&out),
-            Err(DecodeError::OutOfRange { index: 2 })
+            Err(DecodeError::DuplicateLabel { index: 2 })
         );
         encode_labels_into(&labels(3, &[""]), &mut out).expect("no nul");
         assert_eq!(

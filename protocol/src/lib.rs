@@ -101,7 +101,10 @@ mod scan;
 mod wire;
 
 pub use address::Address;
-pub use control::{decode_control, Control, ControlError, Profile};
+pub use control::{
+    decode_control, decode_control_with_secret, Control, ControlError, Profile, MAX_ALPHA,
+    MAX_GAIN, MAX_MIX_WEIGHT, MAX_NAME_BYTES, MAX_PATH_BYTES, MAX_RAMP_S,
+};
 pub use error::{DecodeError, DecodeErrorKind, EncodeError};
 pub use frame::{
     all_finite, decode_frame_into, encode_frame_flat_into, encode_frame_into, frame_message_len,
@@ -111,12 +114,14 @@ pub use labels::{
     decode_labels, encode_labels_into, Labels, LayoutBook, LayoutChange, MAX_LAYOUTS_PER_SOURCE,
 };
 pub use output::{
-    decode_blend_val, decode_components_into, decode_part_into, decode_state, encode_compact_into,
-    encode_components_into, FlatSplit, PartHeader, State, ETHERNET_PAYLOAD,
+    decode_blend_val, decode_components_into, decode_part_into, decode_state, decode_stream,
+    encode_compact_into, encode_components_into, FlatSplit, PartHeader, State, StreamTag,
+    ETHERNET_PAYLOAD, MAX_STREAM_NAME_BYTES,
 };
 pub use reply::{
-    decode_reply, encode_confirm_into, encode_control_into, encode_emotion_list_into,
-    encode_error_into, encode_status_into, EmotionList, Reply,
+    decode_reply, encode_challenge_into, encode_confirm_into, encode_control_into,
+    encode_control_signed_into, encode_emotion_list_into, encode_error_into, encode_status_into,
+    EmotionList, Reply, StatusValue,
 };
 pub use scan::{
     check_datagram, messages, Limits, Message, Messages, TimeTag, BUNDLE_DEPTH_CAP,

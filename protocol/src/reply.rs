@@ -2,8 +2,10 @@
 //!
 //! Every control message is answered to its sender: `<address>/confirm` echoing the accepted
 //! arguments in canonical types, or `/emoshift/error ,ss` (address, message). `/status` is
-//! answered by `/status/confirm` with name/value pairs: `,shsh...`, each counter an OSC string
-//! (its name) followed by an `h` (int64) value, in the order the daemon lists them.
+//! answered by `/status/confirm` with name/value pairs, each an OSC string (its name) followed
+//! by an `h` (int64, counters) or an `s` (text: stream names, models, addresses), in the order
+//! the daemon lists them. A `/subscribe` from beyond loopback is answered by
+//! `/subscribe/challenge ,i` (a cookie to echo).
 
 use rosc::{OscMessage, OscPacket, OscType};
 
@@ -27,8 +29,10 @@ pub enum Reply {
     EmotionList(EmotionList),
     /// `<address>/confirm` of an accepted control, with its echoed arguments.
     Confirm(Control),
-    /// `/status/confirm`: counters as (name, value) pairs, in the daemon's order.
-    Status(Vec<(String, i64)>),
+    /// `/status/confirm`: (name, value) pairs, in the daemon's order.
+    Status(Vec<(String, StatusValue)>),
+    /// `/subscribe/challenge ,i`: echo this cookie in the `/subscribe` to be subscribed.
+    Challenge(i32),
     /// `/emoshift/error ,ss`.
     Error {
         /// Address of the refused message.
@@ -36,6 +40,45 @@ pub enum Reply {
         /// Why it was refused.
         message: String,
     },
+}
+
+/// One value of `/status/confirm`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum StatusValue {
+    /// A counter or a measure (`h`).
+    Int(i64),
+    /// A name, a path, an address (`s`).
+    Text(String),
+}
+
+impl StatusValue {
+    /// The number, if it is one.
+    pub fn as_int(&self) -> Option<i64> {
+        match self {
+            StatusValue::Int(v) => Some(*v),
+            StatusValue::Text(_) => None,
+        }
+    }
+
+    /// The text, if it is one.
+    pub fn as_text(&self) -> Option<&str> {
+        match self {
+            StatusValue::Int(_) => None,
+            StatusValue::Text(s) => Some(s),
+        }
+    }
+}
+
+impl From<i64> for StatusValue {
+    fn from(v: i64) -> StatusValue {
+        StatusValue::Int(v)
+    }
+}
+
+impl From<String> for StatusValue {
+    fn from(v: String) -> StatusValue {
+        StatusValue::Text(v)
+    }
 }
 
 /// rosc cannot fail writing into a `Vec`; clear and encode.
@@ -59,6 +102,23 @@ pub fn encode_control_into(control: &Control, out: &mut Vec<u8>) -> usize {
     encode_message(control.address().to_string(), args, out)
 }
 
+/// Encodes a control message carrying the daemon's shared `secret` as its last argument.
+/// Returns the encoded length.
+pub fn encode_control_signed_into(control: &Control, secret: &str, out: &mut Vec<u8>) -> usize {
+    let mut args = control.args();
+    args.push(OscType::String(secret.to_string()));
+    encode_message(control.address().to_string(), sanitize(args), out)
+}
+
+/// Encodes `/subscribe/challenge ,i`. Returns the encoded length.
+pub fn encode_challenge_into(cookie: i32, out: &mut Vec<u8>) -> usize {
+    encode_message(
+        a::SUBSCRIBE_CHALLENGE.to_string(),
+        vec![OscType::Int(cookie)],
+        out,
+    )
+}
+
 fn sanitize(mut args: Vec<OscType>) -> Vec<OscType> {
     for arg in &mut args {
         if let OscType::String(s) = arg {
@@ -77,12 +137,15 @@ pub fn encode_confirm_into(control: &Control, out: &mut Vec<u8>) -> usize {
     encode_message(addr, sanitize(control.args()), out)
 }
 
-/// Encodes `/status/confirm ,shsh...` from (name, value) counter pairs. Returns the length.
-pub fn encode_status_into<S: AsRef<str>>(counters: &[(S, i64)], out: &mut Vec<u8>) -> usize {
-    let mut args = Vec::with_capacity(counters.len() * 2);
-    for (name, value) in counters {
+/// Encodes `/status/confirm` from (name, value) pairs. Returns the length.
+pub fn encode_status_into<S: AsRef<str>>(pairs: &[(S, StatusValue)], out: &mut Vec<u8>) -> usize {
+    let mut args = Vec::with_capacity(pairs.len() * 2);
+    for (name, value) in pairs {
         args.push(OscType::String(osc_string(name.as_ref())));
-        args.push(OscType::Long(*value));
+        args.push(match value {
+            StatusValue::Int(v) => OscType::Long(*v),
+            StatusValue::Text(s) => OscType::String(osc_string(s)),
+        });
     }
     encode_message(format!("{}{}", a::STATUS, a::CONFIRM_SUFFIX), args, out)
 }
@@ -121,6 +184,12 @@ pub fn encode_error_into(address: &str, message: &str, out: &mut Vec<u8>) -> usi
 /// [`ControlError`] if it is not a well-formed reply.
 pub fn decode_reply(msg: &[u8]) -> Result<Reply, ControlError> {
     let m = decode_osc(msg)?;
+    if m.addr == a::SUBSCRIBE_CHALLENGE {
+        return match m.args.as_slice() {
+            [OscType::Int(c)] => Ok(Reply::Challenge(*c)),
+            _ => Err(DecodeError::WrongTypeTags.into()),
+        };
+    }
     if m.addr == a::ERROR {
         return match <[OscType; 2]>::try_from(m.args) {
             Ok([OscType::String(address), OscType::String(message)]) => {
@@ -176,7 +245,7 @@ fn parse_emotion_list(args: Vec<OscType>) -> Option<EmotionList> {
     })
 }
 
-fn parse_status(args: Vec<OscType>) -> Result<Vec<(String, i64)>, ControlError> {
+fn parse_status(args: Vec<OscType>) -> Result<Vec<(String, StatusValue)>, ControlError> {
     if args.len() % 2 != 0 {
         return Err(DecodeError::WrongTypeTags.into());
     }
@@ -184,7 +253,8 @@ fn parse_status(args: Vec<OscType>) -> Result<Vec<(String, i64)>, ControlError> 
     let mut it = args.into_iter();
     while let (Some(name), Some(value)) = (it.next(), it.next()) {
         match (name, value) {
-            (OscType::String(n), OscType::Long(v)) => out.push((n, v)),
+            (OscType::String(n), OscType::Long(v)) => out.push((n, StatusValue::Int(v))),
+            (OscType::String(n), OscType::String(v)) => out.push((n, StatusValue::Text(v))),
             _ => return Err(DecodeError::WrongTypeTags.into()),
         }
     }

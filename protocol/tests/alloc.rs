@@ -11,8 +11,12 @@ fn frame_decode_edit_encode_allocates_nothing() {
     src.set_missing(5, true);
     let mut wire = Vec::with_capacity(1_500);
     encode_frame_into(&src, &mut wire).expect("finite");
+    let tag = StreamTag {
+        id: 3,
+        name: "alice",
+    };
     let mut compact = wire.clone();
-    encode_compact_into(&src, "neutral", 0.5, &mut compact).expect("valid");
+    encode_compact_into(&tag, &src, "neutral", 0.5, &mut compact).expect("valid");
     let mut buf = FrameBuf::with_max_markers(109);
     let mut out = Vec::with_capacity(1_500);
     let split = FlatSplit::new(ETHERNET_PAYLOAD).expect("fits");
@@ -32,11 +36,13 @@ fn frame_decode_edit_encode_allocates_nothing() {
             buf.positions_mut()[0] += 1.0;
             buf.set_header(i, i64::from(i) * 8_333);
             encode_frame_into(&buf, &mut out).expect("finite");
-            encode_compact_into(&buf, "joy", 0.5, &mut out).expect("valid");
+            encode_compact_into(&tag, &buf, "joy", 0.5, &mut out).expect("valid");
             for p in 0..split.part_count(buf.marker_count()) {
-                split.encode_part_into(&buf, p, &mut out);
+                split
+                    .encode_part_into(&tag, &buf, p, &mut out)
+                    .expect("valid");
             }
-            encode_components_into(&u, &vmc, &mut out).expect("valid");
+            encode_components_into(&tag, &u, &vmc, &mut out).expect("valid");
         }
     });
     assert_eq!(info.count_total, 0, "{info:?}");

@@ -182,9 +182,13 @@ fn a_109_marker_compact_bundle_fits_one_ethernet_payload() {
     let mut f = FrameBuf::new();
     f.set_frame(1, 2, &face(109)).expect("valid");
     let mut out = Vec::new();
-    let n = protocol::encode_compact_into(&f, "neutral", 0.5, &mut out).expect("valid");
-    assert_eq!(n, 1_424);
-    let long = "x".repeat(55);
-    let n = protocol::encode_compact_into(&f, &long, 0.5, &mut out).expect("valid");
+    let tag = protocol::StreamTag {
+        id: 1,
+        name: "alice",
+    };
+    let n = protocol::encode_compact_into(&tag, &f, "neutral", 0.5, &mut out).expect("valid");
+    assert_eq!(n, 1_464);
+    let long = "x".repeat(15);
+    let n = protocol::encode_compact_into(&tag, &f, &long, 0.5, &mut out).expect("valid");
     assert_eq!(n, protocol::ETHERNET_PAYLOAD);
 }

@@ -183,8 +183,10 @@ proptest! {
     #[test]
     fn status_round_trips(counters in prop::collection::vec(("[a-z_]{1,20}", any::<i64>()), 0..20)) {
         let mut out = Vec::new();
-        encode_status_into(&counters, &mut out);
-        prop_assert_eq!(decode_reply(&out), Ok(Reply::Status(counters)));
+        let pairs: Vec<(String, StatusValue)> =
+            counters.into_iter().map(|(k, v)| (k, StatusValue::Int(v))).collect();
+        encode_status_into(&pairs, &mut out);
+        prop_assert_eq!(decode_reply(&out), Ok(Reply::Status(pairs)));
     }
 
     #[test]
@@ -192,18 +194,21 @@ proptest! {
         f in frame_strategy(),
         target in "[a-z]{0,20}",
         amount in -2.0f32..2.0,
+        (id, name) in (any::<i32>(), "[a-z0-9.:/]{0,64}"),
     ) {
         let mut out = Vec::new();
-        let n = encode_compact_into(&f, &target, amount, &mut out).expect("valid");
+        let tag = StreamTag { id, name: &name };
+        let n = encode_compact_into(&tag, &f, &target, amount, &mut out).expect("valid");
         prop_assert_eq!(n, out.len());
         let msgs: Vec<_> = messages(&out, &Limits::default()).expect("valid bundle").collect();
-        prop_assert_eq!(msgs.len(), 2);
+        prop_assert_eq!(msgs.len(), 3);
+        prop_assert_eq!(decode_stream(msgs[0].bytes), Ok((id, name.as_str())));
         let mut g = FrameBuf::new();
-        decode_frame_into(msgs[0].bytes, &mut g).expect("frame");
+        decode_frame_into(msgs[1].bytes, &mut g).expect("frame");
         prop_assert!(same_positions(g.positions(), f.positions()));
-        let ours = decode_state(msgs[1].bytes).expect("state");
+        let ours = decode_state(msgs[2].bytes).expect("state");
         prop_assert_eq!((ours.target, ours.amount), (target.as_str(), amount));
-        let state = decode_osc(msgs[1].bytes).expect("state");
+        let state = decode_osc(msgs[2].bytes).expect("state");
         prop_assert_eq!(state.addr.as_str(), "/emoshift/state");
         prop_assert_eq!(state.args, vec![OscType::String(target), OscType::Float(amount)]);
     }
@@ -211,23 +216,28 @@ proptest! {
     #[test]
     fn flat_split_parts_fit_and_reassemble(f in frame_strategy(), max in 40usize..4096) {
         let Ok(split) = FlatSplit::new(max) else {
-            prop_assert!(max < 60, "a part of {} bytes fits one marker", max);
+            prop_assert!(max < 200, "a part of {} bytes fits one marker", max);
             return Ok(());
         };
+        let name = "n".repeat(MAX_STREAM_NAME_BYTES);
+        let tag = StreamTag { id: 7, name: &name };
         let n = f.marker_count();
         let mut pos = vec![0f32; 3 * n];
         let mut out = Vec::new();
         let mut covered = 0;
         for part in 0..split.part_count(n) {
-            let len = split.encode_part_into(&f, part, &mut out);
+            let len = split.encode_part_into(&tag, &f, part, &mut out).expect("valid");
             prop_assert!(len > 0 && len <= max, "part {} is {} bytes, max {}", part, len, max);
-            let h = decode_part_into(&out, &mut pos).expect("own part decodes");
+            let msgs: Vec<_> = messages(&out, &Limits::default()).expect("a bundle").collect();
+            prop_assert_eq!(msgs.len(), 2);
+            prop_assert_eq!(decode_stream(msgs[0].bytes), Ok((7, name.as_str())));
+            let h = decode_part_into(msgs[1].bytes, &mut pos).expect("own part decodes");
             prop_assert_eq!((h.first_marker, h.total_markers), (covered, n));
             prop_assert_eq!(h.frame_number, f.header().frame_number);
             covered += h.marker_count;
         }
         prop_assert_eq!(covered, n);
-        prop_assert_eq!(split.encode_part_into(&f, split.part_count(n), &mut out), 0);
+        prop_assert_eq!(split.encode_part_into(&tag, &f, split.part_count(n), &mut out), Ok(0));
         prop_assert!(same_positions(&pos, f.positions()));
     }
 
@@ -237,15 +247,17 @@ proptest! {
         names in prop::collection::vec(("[A-Za-z]{1,10}", 0usize..45), 0..6),
     ) {
         let mut out = Vec::new();
-        encode_components_into(&u, &names, &mut out).expect("no nul");
+        let tag = StreamTag { id: 2, name: "bob" };
+        encode_components_into(&tag, &u, &names, &mut out).expect("no nul");
         let msgs: Vec<_> = messages(&out, &Limits::default()).expect("valid").collect();
+        prop_assert_eq!(decode_stream(msgs[0].bytes), Ok((2, "bob")));
+        let msgs = &msgs[1..];
         let mut got = [0f32; 64];
         let n = decode_components_into(msgs[0].bytes, &mut got).expect("components");
         prop_assert_eq!(&got[..n], u.as_slice());
         let kept: Vec<_> = names.iter().filter(|(_, i)| *i < u.len()).collect();
         if names.is_empty() {
             prop_assert_eq!(msgs.len(), 1);
-            prop_assert_eq!(msgs[0].timetag, None);
         } else {
             prop_assert_eq!(msgs.len(), kept.len() + 2);
             for ((name, i), m) in kept.iter().zip(&msgs[1..]) {
@@ -259,26 +271,39 @@ proptest! {
     }
 }
 
-fn finite() -> impl Strategy<Value = f32> {
-    prop::num::f32::NORMAL | prop::num::f32::ZERO | prop::num::f32::SUBNORMAL
-}
-
+/// Every control within its documented limits.
 fn control_strategy() -> impl Strategy<Value = Control> {
     let text = "[ -~]{0,30}";
     prop_oneof![
         text.prop_map(Control::Target),
-        finite().prop_map(Control::Amount),
-        finite().prop_map(|v| Control::Ramp(v.abs())),
-        (0..=i32::MAX as u32, finite())
+        (0.0f32..=1.0).prop_map(Control::Amount),
+        (0.0f32..=MAX_RAMP_S).prop_map(Control::Ramp),
+        (0..=i32::MAX as u32, -MAX_ALPHA..=MAX_ALPHA)
             .prop_map(|(component, value)| Control::Alpha { component, value }),
-        (0..=i32::MAX as u32, finite())
+        (0..=i32::MAX as u32, -MAX_GAIN..=MAX_GAIN)
             .prop_map(|(component, gain)| Control::Gain { component, gain }),
         any::<bool>().prop_map(Control::Bypass),
-        (1..=u16::MAX, prop::sample::select(Profile::ALL.to_vec()))
-            .prop_map(|(port, profile)| Control::Subscribe { port, profile }),
+        (
+            1..=u16::MAX,
+            prop::sample::select(Profile::ALL.to_vec()),
+            prop::option::of(text),
+            prop::option::of(any::<i32>()),
+        )
+            .prop_map(|(port, profile, performer, cookie)| Control::Subscribe {
+                port,
+                profile,
+                performer,
+                cookie,
+            }),
         (1..=u16::MAX).prop_map(|port| Control::Unsubscribe { port }),
         text.prop_map(Control::ModelLoad),
-        (text, prop::option::of(text)).prop_map(|(path, raw)| Control::RecordStart { path, raw }),
+        (text, prop::option::of(text), any::<bool>()).prop_map(|(path, raw, overwrite)| {
+            Control::RecordStart {
+                path,
+                raw,
+                overwrite,
+            }
+        }),
         Just(Control::RecordStop),
         Just(Control::Status),
     ]

@@ -161,3 +161,28 @@ fn string_float<'a>(msg: &'a [u8], expected: &str) -> Result<(&'a str, f32), Dec
     }
     Ok((text, value))
 }
+
+/// Decodes `/emoshift/stream ,is`: the stream id and name.
+///
+/// # Errors
+/// [`DecodeError`] if it is not that message.
+pub fn decode_stream(msg: &[u8]) -> Result<(i32, &str), DecodeError> {
+    let (address, tags, mut r) = read_head(msg)?;
+    if address != crate::address::STREAM {
+        return Err(DecodeError::UnknownAddress);
+    }
+    if tags != b"is" {
+        return Err(DecodeError::WrongTypeTags);
+    }
+    let id = r.i32()?;
+    let at = r.pos();
+    let name =
+        std::str::from_utf8(r.str_bytes()?).map_err(|_| DecodeError::BadString { offset: at })?;
+    if r.remaining() != 0 {
+        return Err(DecodeError::TrailingBytes {
+            offset: r.pos(),
+            extra: r.remaining(),
+        });
+    }
+    Ok((id, name))
+}
