@@ -46,6 +46,9 @@ pub enum ReadError {
     /// The underlying reader failed.
     #[error("cannot read")]
     Io(#[from] std::io::Error),
+    /// The file is not one to read (a device, a FIFO, too large).
+    #[error(transparent)]
+    Open(#[from] crate::file::OpenError),
     /// The file extension names no supported format.
     #[error("unknown take format {0:?} (expected .c3d, .trc or .csv)")]
     UnknownFormat(PathBuf),

@@ -51,8 +51,16 @@ impl Format {
 /// [`ReadError::UnknownFormat`] for an unsupported extension, otherwise whatever the format's
 /// reader reports (I/O, malformed or truncated content, invalid values).
 pub fn load(path: &Path) -> Result<Take, ReadError> {
+    load_limited(path, crate::file::DEFAULT_MAX_TAKE_BYTES)
+}
+
+/// [`load`] of a regular file of at most `max_bytes`.
+///
+/// # Errors
+/// As [`load`]; [`ReadError::Open`] for a device, a FIFO or a file past the limit.
+pub fn load_limited(path: &Path, max_bytes: u64) -> Result<Take, ReadError> {
     let format = Format::from_path(path).ok_or_else(|| ReadError::UnknownFormat(path.into()))?;
-    let reader = BufReader::new(File::open(path)?);
+    let reader = BufReader::new(crate::file::open_bounded(path, max_bytes)?);
     let take = match format {
         Format::C3d => c3d::read(reader)?,
         Format::Trc => trc::read(reader)?,

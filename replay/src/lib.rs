@@ -10,6 +10,7 @@
 pub mod c3d;
 pub mod csv;
 pub mod error;
+pub mod file;
 pub mod format;
 pub mod pacer;
 pub mod record;
@@ -20,5 +21,5 @@ pub mod take;
 pub mod trc;
 
 pub use error::{ReadError, TakeError, WriteError};
-pub use format::{load, save, write_as, Format};
+pub use format::{load, load_limited, save, write_as, Format};
 pub use take::{Take, Units};

@@ -30,18 +30,21 @@ pub const REGIONS_FILE: &str = "regions.toml";
 #[derive(Debug, thiserror::Error)]
 pub enum SessionError {
     /// The file could not be read or written.
-    #[error("cannot access {path:?}: {source}")]
+    #[error("cannot access {path:?}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The I/O error.
         source: std::io::Error,
     },
+    /// The file is not one to read (a device, a FIFO, too large).
+    #[error(transparent)]
+    Open(#[from] crate::file::OpenError),
     /// The TOML is malformed, misses a field or has an unknown one.
-    #[error("invalid toml: {0}")]
+    #[error("invalid toml")]
     Parse(#[from] toml::de::Error),
     /// A problem inside a specific file.
-    #[error("in {path:?}: {source}")]
+    #[error("in {path:?}")]
     InFile {
         /// The file.
         path: PathBuf,
@@ -69,7 +72,7 @@ pub enum SessionError {
     #[error("region {0:?} must have a name and at least one label or pattern")]
     EmptyRegionSpec(String),
     /// A region pattern is not a valid glob.
-    #[error("region {region:?}: bad pattern {pattern:?}: {source}")]
+    #[error("region {region:?}: bad pattern {pattern:?}")]
     BadPattern {
         /// Region name.
         region: String,
@@ -95,7 +98,7 @@ pub enum SessionError {
         patterns: Vec<String>,
     },
     /// Serialising to TOML failed.
-    #[error("cannot serialise to toml: {0}")]
+    #[error("cannot serialise to toml")]
     Serialize(#[from] toml::ser::Error),
 }
 
@@ -109,10 +112,10 @@ impl SessionError {
 }
 
 fn read(path: &Path) -> Result<String, SessionError> {
-    std::fs::read_to_string(path).map_err(|source| SessionError::Io {
-        path: path.into(),
-        source,
-    })
+    Ok(crate::file::read_to_string_bounded(
+        path,
+        crate::file::DEFAULT_MAX_TEXT_BYTES,
+    )?)
 }
 
 /// One take of a session.
@@ -334,16 +337,24 @@ fn matcher(region: &str, pattern: &str) -> Result<GlobMatcher, SessionError> {
 mod tests {
     use super::*;
 
+    /// The error and its causes, as the binary prints them.
+    fn chain(e: &dyn std::error::Error) -> String {
+        let mut text = e.to_string();
+        let mut source = e.source();
+        while let Some(s) = source {
+            text = format!("{text}: {s}");
+            source = s.source();
+        }
+        text
+    }
+
     #[test]
     fn manifests_reject_bad_input_and_resolve_paths() {
         let missing = "rate_hz = 120\n[[take]]\nfile = \"a.c3d\"\nsentence = \"s01\"\n";
         let err = Session::parse(missing).expect_err("missing emotion");
-        assert!(err.to_string().contains("emotion"), "{err}");
+        assert!(chain(&err).contains("emotion"), "{err}");
         let unknown = format!("{missing}emotion = \"happy\"\nmood = \"x\"\n");
-        assert!(Session::parse(&unknown)
-            .expect_err("unknown field")
-            .to_string()
-            .contains("mood"));
+        assert!(chain(&Session::parse(&unknown).expect_err("unknown field")).contains("mood"));
         assert!(matches!(
             Session::parse("rate_hz = 120\n"),
             Err(SessionError::NoTakes)

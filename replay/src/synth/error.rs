@@ -98,7 +98,7 @@ pub enum SynthError {
     #[error(transparent)]
     Take(#[from] crate::TakeError),
     /// Writing a take file failed.
-    #[error("cannot write take {path:?}: {source}")]
+    #[error("cannot write take {path:?}")]
     Write {
         /// The file.
         path: PathBuf,
@@ -106,7 +106,7 @@ pub enum SynthError {
         source: crate::WriteError,
     },
     /// A file or folder could not be read or written.
-    #[error("cannot access {path:?}: {source}")]
+    #[error("cannot access {path:?}")]
     Io {
         /// The path.
         path: PathBuf,
@@ -114,7 +114,7 @@ pub enum SynthError {
         source: std::io::Error,
     },
     /// A truth file is not valid JSON for its type.
-    #[error("bad truth json {path:?}: {source}")]
+    #[error("bad truth json {path:?}")]
     Json {
         /// The file.
         path: PathBuf,
