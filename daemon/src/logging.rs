@@ -1,5 +1,9 @@
 //! Tracing subscriber for the binary: `RUST_LOG` is respected (default `info`, `warn` for the
-//! demo, whose own summary says what the daemon's status lines would), to stderr.
+//! demo, whose own summary says what the daemon's status lines would), to stderr. Every event
+//! of emoshift has the target `emoshift`, so `RUST_LOG=emoshift=debug` selects them. Colour
+//! only on a terminal, and never with `NO_COLOR` set.
+
+use std::io::IsTerminal;
 
 use tracing_subscriber::EnvFilter;
 
@@ -10,6 +14,29 @@ pub fn install(default: &str) {
     let _ = tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
+        .with_ansi(colour(
+            std::io::stderr().is_terminal(),
+            std::env::var_os("NO_COLOR"),
+        ))
         .with_target(false)
         .try_init();
+}
+
+/// Colour when writing to a terminal, unless `NO_COLOR` is set to anything but empty
+/// (<https://no-color.org>).
+fn colour(terminal: bool, no_color: Option<std::ffi::OsString>) -> bool {
+    terminal && no_color.is_none_or(|v| v.is_empty())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::colour;
+
+    #[test]
+    fn colour_only_on_a_terminal_without_no_color() {
+        assert!(colour(true, None));
+        assert!(!colour(false, None));
+        assert!(!colour(true, Some("1".into())));
+        assert!(colour(true, Some("".into())));
+    }
 }

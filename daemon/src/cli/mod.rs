@@ -15,6 +15,10 @@ pub use offline::{
 #[derive(Debug, Parser)]
 #[command(name = "emoshift", version, about, long_about = None)]
 pub struct Cli {
+    /// Largest input file read (takes, models, manifests), MB; devices and FIFOs are refused
+    /// whatever their size.
+    #[arg(long, global = true, default_value_t = 8192, value_name = "MB")]
+    pub max_input_mb: u64,
     /// What to do.
     #[command(subcommand)]
     pub command: Command,

@@ -53,6 +53,9 @@ pub struct SynthArgs {
     /// File format of the takes: c3d, trc or csv.
     #[arg(long, default_value = "c3d")]
     pub format: String,
+    /// Overwrite the output if it exists.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `emoshift info`.
@@ -72,6 +75,9 @@ pub struct ConvertArgs {
     pub input: PathBuf,
     /// Output take; its extension picks the format.
     pub output: PathBuf,
+    /// Overwrite the output if it exists.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `emoshift train`.
@@ -130,6 +136,9 @@ pub struct TrainArgs {
     /// Do not learn per-marker plausible regions (which drop swapped or drifting labels).
     #[arg(long)]
     pub no_bounds: bool,
+    /// Overwrite the output if it exists.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `emoshift project`.
@@ -143,6 +152,9 @@ pub struct ProjectArgs {
     /// Output CSV: `frame,time,c0,...,c{m-1}`.
     #[arg(long)]
     pub out: PathBuf,
+    /// Overwrite the output if it exists.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `emoshift edit`.
@@ -184,6 +196,9 @@ pub struct EditArgs {
     /// Keep the take's gaps in the output instead of filling them from the model.
     #[arg(long)]
     pub keep_gaps: bool,
+    /// Overwrite the output if it exists.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `emoshift inspect`.
@@ -241,4 +256,7 @@ pub struct AnalyzeArgs {
     /// Store the roles and emotion levels in the model file.
     #[arg(long)]
     pub write_model: bool,
+    /// Overwrite the output if it exists.
+    #[arg(long)]
+    pub force: bool,
 }

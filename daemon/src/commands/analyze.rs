@@ -11,6 +11,7 @@ use crate::offline;
 use crate::offline::analysis::{self, Inputs};
 
 pub(crate) fn run(args: &AnalyzeArgs) -> Result<()> {
+    offline::output::check_out_dir(&args.out, args.force)?;
     let to = Report {
         dir: &args.out,
         write_model: args.write_model,

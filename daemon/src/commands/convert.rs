@@ -5,6 +5,7 @@ use anyhow::{Context, Result};
 use crate::cli::ConvertArgs;
 
 pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
+    crate::offline::output::check_out(&args.output, &[&args.input], args.force)?;
     let take = crate::offline::load_take(&args.input)?;
     replay::save(&args.output, &take).with_context(|| format!("{}", args.output.display()))?;
     let gaps: usize = take.missing.iter().filter(|&&m| m).count();

@@ -25,6 +25,11 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
         add_from,
         keep_gaps: args.keep_gaps,
     };
+    let mut inputs = vec![args.file.as_path(), args.model.as_path()];
+    inputs.extend(args.replace_emotion_from.as_deref());
+    inputs.extend(args.add_emotion_from.as_deref());
+    inputs.extend(args.other_model.as_deref());
+    offline::output::check_out(&args.out, &inputs, args.force)?;
     let model = offline::load_model(&args.model)?;
     let take = offline::load_take(&args.file)?;
     let out =

@@ -42,6 +42,7 @@ pub fn main_with(cli: Cli) -> std::process::ExitCode {
 /// # Errors
 /// Whatever the command reports; the binary prints the chain on one line.
 pub fn run(cli: Cli) -> Result<()> {
+    crate::offline::set_input_limit(cli.max_input_mb.saturating_mul(1 << 20));
     match cli.command {
         Command::Synth(args) => synth::run(&args),
         Command::Info(args) => info::run(&args),

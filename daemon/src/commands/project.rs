@@ -8,6 +8,7 @@ use crate::cli::ProjectArgs;
 use crate::offline;
 
 pub(crate) fn run(args: &ProjectArgs) -> Result<()> {
+    offline::output::check_out(&args.out, &[&args.file, &args.model], args.force)?;
     let model = crate::offline::load_model(&args.model)?;
     let take = offline::load_take(&args.file)?;
     let map = offline::match_take(&model, &take, &args.file)?;

@@ -17,8 +17,9 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     let mut raw = match &args.config {
         Some(path) => {
             let text =
-                std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-            RawConfig::from_toml(&text).with_context(|| format!("{}", path.display()))?
+                replay::file::read_to_string_bounded(path, replay::file::DEFAULT_MAX_TEXT_BYTES)?;
+            RawConfig::from_toml(&text)
+                .map_err(|e| UsageError(format!("{}: {e}", path.display())))?
         }
         None => RawConfig::default(),
     };
@@ -51,6 +52,7 @@ pub(crate) fn run(args: &ServeArgs) -> Result<()> {
         let shutdown = CancellationToken::new();
         let bound = crate::serve::bind(config).await?;
         tracing::info!(
+            target: "emoshift",
             frames = %bound.frame_addr()?,
             control = %bound.control_addr()?,
             "serving"
@@ -82,6 +84,6 @@ async fn cancel_on_signal(token: CancellationToken) {
     }
     #[cfg(not(unix))]
     let _ = tokio::signal::ctrl_c().await;
-    tracing::info!("shutting down");
+    tracing::info!(target: "emoshift", "shutting down");
     token.cancel();
 }

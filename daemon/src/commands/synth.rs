@@ -40,6 +40,7 @@ pub(crate) fn run(args: &SynthArgs) -> Result<()> {
         },
     };
     params.validate().map_err(|e| UsageError(e.to_string()))?;
+    crate::offline::output::check_out_dir(&args.out, args.force)?;
     let summary = write_session(&args.out, &params, format)
         .with_context(|| format!("cannot write the session to {}", args.out.display()))?;
     crate::out!(

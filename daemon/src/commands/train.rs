@@ -26,7 +26,8 @@ fn regions(args: &TrainArgs) -> Result<Option<Regions>> {
         let p = args.manifest.as_ref()?.parent()?.join("regions.toml");
         p.exists().then_some(p)
     });
-    path.map(|path| Regions::load(&path).with_context(|| format!("{}", path.display())))
+    // Its errors name the file already.
+    path.map(|path| Regions::load(&path).map_err(anyhow::Error::from))
         .transpose()
 }
 
@@ -120,6 +121,9 @@ pub(crate) fn options_with_regions(regions: Regions) -> TrainOptions {
 pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     let options = options(args)?;
     let takes = offline::load_inputs(args.manifest.as_deref(), &args.files)?;
+    let mut inputs: Vec<&Path> = takes.iter().map(|t| t.path.as_path()).collect();
+    inputs.extend(args.manifest.as_deref());
+    offline::output::check_out(&args.out, &inputs, args.force)?;
     train_and_save(&takes, &options, &args.out).map(drop)
 }
 

@@ -24,6 +24,8 @@ pub struct Counters {
     pub frame_errors: u64,
     /// Labels messages accepted.
     pub labels_in: u64,
+    /// Labels messages refused (a marker named twice); the source is told.
+    pub labels_refused: u64,
     /// Model markers missing, summed over frames.
     pub missing_markers: u64,
     /// Samples rejected as glitches, summed over frames.

@@ -4,7 +4,9 @@
 use std::sync::Arc;
 
 use ica_core::model::IcaModel;
-use protocol::{FrameBuf, FrameHeader};
+use protocol::{
+    encode_labels_into, FrameBuf, FrameHeader, Labels, StreamTag, MAX_STREAM_NAME_BYTES,
+};
 
 use super::edit_state::EditState;
 use super::frame::FrameProcessor;
@@ -31,9 +33,53 @@ pub enum Order {
     Restart,
 }
 
+/// Who a stream is to its subscribers: `/emoshift/stream ,is`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Identity {
+    /// Stable for the daemon's session; also the layout id of its `/mocap/labels`.
+    pub id: i32,
+    /// The performer's name, or `ip:port/layout` when none is configured; at most
+    /// [`MAX_STREAM_NAME_BYTES`].
+    pub name: String,
+}
+
+impl Identity {
+    /// The identity of stream `id`: `name` cut to [`MAX_STREAM_NAME_BYTES`] at a character
+    /// boundary.
+    pub fn new(id: i32, name: &str) -> Identity {
+        let mut end = name.len().min(MAX_STREAM_NAME_BYTES);
+        while !name.is_char_boundary(end) {
+            end -= 1;
+        }
+        Identity {
+            id,
+            name: name[..end].replace('\0', "?"),
+        }
+    }
+
+    /// The tag the outputs carry.
+    pub fn tag(&self) -> StreamTag<'_> {
+        StreamTag {
+            id: self.id,
+            name: &self.name,
+        }
+    }
+}
+
+/// What [`Stream::process`] made of a frame that came through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Processed {
+    /// Frame numbers since the stream's previous processed frame (1 = none lost).
+    pub frames_since_last: u32,
+    /// The stream's labels go out with this frame: its first, then once a second of frames.
+    pub labels_due: bool,
+}
+
 /// One stream's state and buffers, all sized from its model at creation.
 #[derive(Debug)]
 pub struct Stream {
+    /// Who it is to subscribers.
+    pub identity: Identity,
     /// The model used.
     pub model: Arc<IcaModel>,
     /// Performer index, if a performer owns the stream.
@@ -57,6 +103,11 @@ pub struct Stream {
     u: Vec<f32>,
     /// Edited frame in model order.
     out: Vec<f32>,
+    /// `/mocap/labels` of the output (model order, layout id = stream id); empty if a label
+    /// cannot be sent.
+    labels_msg: Vec<u8>,
+    /// Frames since the labels last went out (0: not yet).
+    frames_since_labels: u32,
     last_frame: Option<i32>,
     /// Frames taken in order (processed).
     pub frames: u64,
@@ -99,6 +150,7 @@ impl Stream {
     /// # Errors
     /// [`LayoutError::NoCommonMarkers`] when the source shares no label with the model.
     pub fn new(
+        identity: Identity,
         model: Arc<IcaModel>,
         performer: Option<usize>,
         source_labels: &[String],
@@ -107,7 +159,18 @@ impl Stream {
         let map = LabelMap::new(model.labels(), source_labels)?;
         let n = model.markers();
         let m = model.components();
+        let labels = Labels {
+            layout_id: identity.id,
+            names: model.labels().to_vec(),
+        };
+        let mut labels_msg = Vec::new();
+        if encode_labels_into(&labels, &mut labels_msg).is_err() {
+            labels_msg.clear();
+        }
         Ok(Stream {
+            identity,
+            labels_msg,
+            frames_since_labels: 0,
             processor: FrameProcessor::new(&model),
             edit: EditState::for_model(&model, lowpass_s),
             map,
@@ -133,7 +196,8 @@ impl Stream {
     /// # Errors
     /// As [`Stream::new`].
     pub fn rebuilt_on(&self, model: Arc<IcaModel>, lowpass_s: f32) -> Result<Stream, LayoutError> {
-        let mut fresh = Stream::new(model, self.performer, &self.source_labels, lowpass_s)?;
+        let who = self.identity.clone();
+        let mut fresh = Stream::new(who, model, self.performer, &self.source_labels, lowpass_s)?;
         fresh.edit.copy_settings(&self.edit);
         fresh.last_frame = self.last_frame;
         fresh.frames = self.frames;
@@ -152,17 +216,39 @@ impl Stream {
         &self.out
     }
 
+    /// The output's `/mocap/labels` (empty when a label cannot be sent).
+    pub fn labels_msg(&self) -> &[u8] {
+        &self.labels_msg
+    }
+
+    /// The markers of `labels` (another model's) that this stream's source does not name.
+    pub fn missing_from_source(&self, labels: &[String]) -> Vec<String> {
+        labels
+            .iter()
+            .filter(|l| !self.source_labels.contains(l))
+            .cloned()
+            .collect()
+    }
+
+    /// The model's markers the source's labels do not name (always missing in this stream).
+    pub fn unmatched_markers(&self) -> usize {
+        self.map
+            .model_to_take
+            .iter()
+            .filter(|t| t.is_none())
+            .count()
+    }
+
     /// Takes one received frame through the stream into `output`: order check, markers into
     /// model order, projection (masked where markers are missing), the live edit, resynthesis
-    /// with the head pose put back. Returns the frame numbers since the previous processed
-    /// frame, or `None` when the frame is dropped (counted in `counters`).
+    /// with the head pose put back. `None` when the frame is dropped (counted in `counters`).
     pub fn process(
         &mut self,
         header: &FrameHeader,
         input: &FrameBuf,
         output: &mut FrameBuf,
         counters: &mut Counters,
-    ) -> Option<u32> {
+    ) -> Option<Processed> {
         let frames = match self.check_order(header.frame_number) {
             Order::Next { frames } => frames,
             Order::Restart => {
@@ -203,7 +289,17 @@ impl Stream {
             counters.frame_errors += 1;
             return None;
         }
-        Some(frames)
+        let labels_due =
+            self.frames_since_labels == 0 || f64::from(self.frames_since_labels) >= rate;
+        self.frames_since_labels = if labels_due {
+            1
+        } else {
+            self.frames_since_labels + 1
+        };
+        Some(Processed {
+            frames_since_last: frames,
+            labels_due,
+        })
     }
 
     /// The input's markers into model order, with their missing flags.
@@ -257,52 +353,5 @@ impl Stream {
 }
 
 #[cfg(test)]
-mod tests {
-    use std::sync::Arc;
-
-    use ica_core::model::Role;
-
-    use super::*;
-    use crate::loopback::synthetic::random_model;
-
-    #[test]
-    fn order_counts_duplicates_and_stale_and_restarts_far_jumps() {
-        let model = Arc::new(random_model(4, 2, 1));
-        let labels: Vec<String> = model.labels().to_vec();
-        let mut s = Stream::new(model, None, &labels, 1.0).expect("same labels");
-        assert_eq!(s.check_order(10), Order::Next { frames: 1 });
-        assert_eq!(s.check_order(12), Order::Next { frames: 2 });
-        assert_eq!(s.check_order(12), Order::Duplicate);
-        assert_eq!(s.check_order(11), Order::Stale);
-        assert_eq!(s.check_order(13), Order::Next { frames: 1 });
-        assert_eq!(s.check_order(-1000), Order::Restart);
-        assert_eq!(s.check_order(-999), Order::Next { frames: 1 });
-        assert_eq!((s.duplicates, s.stale), (1, 1));
-    }
-
-    #[test]
-    fn labelled_components_get_blend_names() {
-        let mut model = random_model(6, 5, 1);
-        for (k, role) in [
-            Role::Emotion,
-            Role::Speech,
-            Role::Other,
-            Role::Speech,
-            Role::Eyelids,
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            model.set_role(k, role).expect("in range");
-        }
-        let names = vmc_names(&model);
-        let expected = [
-            ("emotion", 0),
-            ("speech1", 1),
-            ("speech2", 3),
-            ("eyelids", 4),
-        ];
-        let got: Vec<(&str, usize)> = names.iter().map(|(n, k)| (n.as_str(), *k)).collect();
-        assert_eq!(got, expected);
-    }
-}
+#[path = "stream_tests.rs"]
+mod tests;

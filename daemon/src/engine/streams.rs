@@ -21,14 +21,26 @@ pub struct StreamKey {
     pub layout_id: i32,
 }
 
-/// One stream's counters (frame order is per stream: a late frame of one performer says
-/// nothing about another).
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// One stream's state and counters for `/status` (frame order is per stream: a late frame of
+/// one performer says nothing about another).
+#[derive(Debug, Clone, PartialEq)]
 pub struct StreamStatus {
     /// The stream.
     pub key: StreamKey,
+    /// Its id and name.
+    pub id: i32,
+    /// Its name (the performer's, or `ip:port/layout`).
+    pub name: String,
     /// The performer owning it, if named in the config.
     pub performer: Option<String>,
+    /// Markers of its model.
+    pub model_markers: usize,
+    /// Of those, the ones its source does not name.
+    pub unmatched_markers: usize,
+    /// Target emotion (empty before one is set).
+    pub target: String,
+    /// Amount now.
+    pub amount: f32,
     /// Frames taken in order.
     pub frames: u64,
     /// Duplicate frame numbers dropped.
@@ -78,11 +90,14 @@ impl<M> Performer<M> {
     }
 }
 
-/// All streams, bounded in number against spoofed senders.
+/// All streams, bounded in number against spoofed senders, and the stream ids of the session.
 #[derive(Debug)]
 pub struct Streams {
     map: HashMap<StreamKey, Stream>,
     max_streams: usize,
+    /// A source keeps its id when its stream is made again (new labels, a model swap).
+    ids: HashMap<StreamKey, i32>,
+    next_id: i32,
 }
 
 impl Streams {
@@ -91,7 +106,25 @@ impl Streams {
         Streams {
             map: HashMap::with_capacity(max_streams),
             max_streams,
+            ids: HashMap::with_capacity(max_streams),
+            next_id: 0,
         }
+    }
+
+    /// The session's id of `key`, given on its first stream. Ids of sources gone quiet are
+    /// forgotten once there are many, so spoofed senders cannot grow the table.
+    fn id_for(&mut self, key: StreamKey) -> i32 {
+        if let Some(&id) = self.ids.get(&key) {
+            return id;
+        }
+        if self.ids.len() >= 4 * self.max_streams {
+            let live = &self.map;
+            self.ids.retain(|k, _| live.contains_key(k));
+        }
+        let id = self.next_id;
+        self.next_id = self.next_id.wrapping_add(1).max(0);
+        self.ids.insert(key, id);
+        id
     }
 
     /// The stream of `key`, made by `create` when it does not exist yet (one hash lookup per
@@ -99,13 +132,17 @@ impl Streams {
     pub fn get_or_create(
         &mut self,
         key: StreamKey,
-        create: impl FnOnce() -> Option<Stream>,
+        create: impl FnOnce(i32) -> Option<Stream>,
     ) -> Option<&mut Stream> {
         let full = self.map.len() >= self.max_streams;
+        if !full && !self.map.contains_key(&key) {
+            let id = self.id_for(key);
+            let stream = create(id)?;
+            return Some(self.map.entry(key).or_insert(stream));
+        }
         match self.map.entry(key) {
             Entry::Occupied(e) => Some(e.into_mut()),
-            Entry::Vacant(_) if full => None,
-            Entry::Vacant(e) => Some(e.insert(create()?)),
+            Entry::Vacant(_) => None,
         }
     }
 
@@ -113,6 +150,11 @@ impl Streams {
     pub fn forget(&mut self, source: SocketAddr, layout_id: i32) {
         self.map
             .retain(|k, _| !(k.source == source && k.layout_id == layout_id));
+    }
+
+    /// Every stream, to read.
+    pub fn iter(&self) -> impl Iterator<Item = (&StreamKey, &Stream)> {
+        self.map.iter()
     }
 
     /// Every stream.
@@ -137,13 +179,19 @@ impl Streams {
             .iter()
             .map(|(key, s)| StreamStatus {
                 key: *key,
+                id: s.identity.id,
+                name: s.identity.name.clone(),
                 performer: s.performer.map(|i| performers[i].name.clone()),
+                model_markers: s.model.markers(),
+                unmatched_markers: s.unmatched_markers(),
+                target: s.edit.target().to_string(),
+                amount: s.edit.amount(),
                 frames: s.frames,
                 duplicates: s.duplicates,
                 stale: s.stale,
             })
             .collect();
-        out.sort_by_key(|s| (s.key.source, s.key.layout_id));
+        out.sort_by_key(|s| s.id);
         out
     }
 }

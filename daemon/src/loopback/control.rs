@@ -4,7 +4,9 @@ use std::net::SocketAddr;
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
-use protocol::{decode_reply, encode_control_into, Control, Reply};
+use protocol::{
+    decode_reply, encode_control_into, encode_control_signed_into, Control, Reply, StatusValue,
+};
 use tokio::net::UdpSocket;
 
 /// How long a request waits for its reply.
@@ -16,6 +18,8 @@ pub const REPLY_WAIT: Duration = Duration::from_secs(5);
 pub struct ControlClient {
     socket: UdpSocket,
     to: SocketAddr,
+    /// The daemon's shared secret, added to mutating controls.
+    secret: Option<String>,
 }
 
 impl ControlClient {
@@ -24,12 +28,40 @@ impl ControlClient {
     /// # Errors
     /// No loopback socket.
     pub async fn new(to: SocketAddr) -> Result<ControlClient> {
+        ControlClient::bind(([127, 0, 0, 1], 0).into(), to).await
+    }
+
+    /// A client on `local` (another loopback address stands in for another host).
+    ///
+    /// # Errors
+    /// No socket there.
+    pub async fn bind(local: SocketAddr, to: SocketAddr) -> Result<ControlClient> {
         Ok(ControlClient {
-            socket: UdpSocket::bind("127.0.0.1:0")
+            socket: UdpSocket::bind(local)
                 .await
                 .context("cannot open a udp socket")?,
             to,
+            secret: None,
         })
+    }
+
+    /// Adds `secret` to every mutating control from now on.
+    pub fn with_secret(mut self, secret: &str) -> ControlClient {
+        self.secret = Some(secret.to_string());
+        self
+    }
+
+    /// The daemon's control address.
+    pub fn daemon(&self) -> SocketAddr {
+        self.to
+    }
+
+    /// Its own address.
+    ///
+    /// # Errors
+    /// The socket has none (never, once bound).
+    pub fn addr(&self) -> Result<SocketAddr> {
+        Ok(self.socket.local_addr()?)
     }
 
     /// Sends `control` and returns the daemon's reply (an error reply included).
@@ -38,7 +70,12 @@ impl ControlClient {
     /// No reply within [`REPLY_WAIT`], or one that does not decode.
     pub async fn request(&self, control: &Control) -> Result<Reply> {
         let mut out = Vec::new();
-        encode_control_into(control, &mut out);
+        match &self.secret {
+            Some(secret) if control.is_mutating() => {
+                encode_control_signed_into(control, secret, &mut out)
+            }
+            _ => encode_control_into(control, &mut out),
+        };
         self.socket.send_to(&out, self.to).await?;
         let mut buf = vec![0; protocol::MAX_UDP_PAYLOAD];
         loop {
@@ -68,7 +105,7 @@ impl ControlClient {
     ///
     /// # Errors
     /// As [`ControlClient::request`], or a reply that is not a status.
-    pub async fn status(&self) -> Result<Vec<(String, i64)>> {
+    pub async fn status(&self) -> Result<Vec<(String, StatusValue)>> {
         match self.request(&Control::Status).await? {
             Reply::Status(pairs) => Ok(pairs),
             other => bail!("unexpected reply to /status: {other:?}"),
@@ -77,6 +114,17 @@ impl ControlClient {
 }
 
 /// The counter `name` of a `/status` reply.
-pub fn counter(status: &[(String, i64)], name: &str) -> Option<i64> {
-    status.iter().find(|(k, _)| k == name).map(|(_, v)| *v)
+pub fn counter(status: &[(String, StatusValue)], name: &str) -> Option<i64> {
+    status
+        .iter()
+        .find(|(k, _)| k == name)
+        .and_then(|(_, v)| v.as_int())
+}
+
+/// The text `name` of a `/status` reply.
+pub fn text<'a>(status: &'a [(String, StatusValue)], name: &str) -> Option<&'a str> {
+    status
+        .iter()
+        .find(|(k, _)| k == name)
+        .and_then(|(_, v)| v.as_text())
 }

@@ -8,9 +8,9 @@ pub mod control;
 pub mod daemon;
 pub mod receiver;
 pub mod source;
-pub mod synthetic;
 
-pub use control::{counter, ControlClient};
+pub use crate::synthetic;
+pub use control::{counter, text, ControlClient};
 pub use daemon::Daemon;
 pub use receiver::{Collecting, Received, Receiver};
 pub use source::Source;

@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use protocol::{
-    decode_components_into, decode_frame_into, decode_state, messages, Address, Control, FrameBuf,
-    FrameHeader, Limits, Profile, State,
+    decode_components_into, decode_frame_into, decode_labels, decode_state, decode_stream,
+    messages, Address, Control, FrameBuf, FrameHeader, Labels, Limits, Profile, State,
 };
 use tokio::net::UdpSocket;
 use tokio::task::JoinHandle;
@@ -21,11 +21,18 @@ use crate::serve::net::bind_receiver;
 /// How long a receiver collecting until a quiet spell waits for its first datagram.
 pub const FIRST_WAIT: Duration = Duration::from_secs(5);
 
+/// How often a subscribed receiver renews its lease (the daemon's default lease is 10 s).
+pub const RENEW_EVERY: Duration = Duration::from_secs(3);
+
 /// What one datagram carried (emoshift sends at most one frame per datagram).
 #[derive(Debug)]
 pub struct Received<'a> {
     /// When it was read off the socket.
     pub at: Instant,
+    /// The stream it belongs to: id and name.
+    pub stream: Option<(i32, &'a str)>,
+    /// A stream's labels (layout id = stream id).
+    pub labels: Option<Labels>,
     /// The frame (compact profile), with its header.
     pub frame: Option<(FrameHeader, &'a FrameBuf)>,
     /// The emotion state that came with it.
@@ -53,23 +60,59 @@ impl Receiver {
     /// # Errors
     /// No socket.
     pub fn bind() -> Result<Receiver> {
-        let socket =
-            bind_receiver(([127, 0, 0, 1], 0).into()).context("cannot open a udp socket")?;
+        Receiver::bind_at(([127, 0, 0, 1], 0).into())
+    }
+
+    /// A receiver on `addr` (a loopback address other than 127.0.0.1 stands in for another
+    /// host; a fixed port for a static target).
+    ///
+    /// # Errors
+    /// No socket there.
+    pub fn bind_at(addr: SocketAddr) -> Result<Receiver> {
+        let socket = bind_receiver(addr).context("cannot open a udp socket")?;
         Ok(Receiver {
             socket: Arc::new(socket),
         })
     }
 
-    /// A receiver subscribed through `/subscribe` with `profile`.
+    /// A receiver subscribed through `/subscribe` with `profile`, renewing its lease every
+    /// [`RENEW_EVERY`] for as long as a clone of it lives.
     ///
     /// # Errors
     /// No socket, or the daemon did not confirm.
     pub async fn subscribe(control: &ControlClient, profile: Profile) -> Result<Receiver> {
+        Receiver::subscribe_to(control, profile, None).await
+    }
+
+    /// [`Receiver::subscribe`] to one performer's stream only (`None`: every stream).
+    ///
+    /// # Errors
+    /// No socket, or the daemon did not confirm.
+    pub async fn subscribe_to(
+        control: &ControlClient,
+        profile: Profile,
+        performer: Option<&str>,
+    ) -> Result<Receiver> {
         let me = Receiver::bind()?;
-        let port = me.addr()?.port();
-        control
-            .confirm(&Control::Subscribe { port, profile })
-            .await?;
+        let subscribe = Control::Subscribe {
+            port: me.addr()?.port(),
+            profile,
+            performer: performer.map(String::from),
+            cookie: None,
+        };
+        control.confirm(&subscribe).await?;
+        let (alive, daemon) = (Arc::downgrade(&me.socket), control.daemon());
+        tokio::spawn(async move {
+            let Ok(renewer) = ControlClient::new(daemon).await else {
+                return;
+            };
+            loop {
+                tokio::time::sleep(RENEW_EVERY).await;
+                if alive.upgrade().is_none() || renewer.request(&subscribe).await.is_err() {
+                    return;
+                }
+            }
+        });
         Ok(me)
     }
 
@@ -155,8 +198,11 @@ where
             continue;
         };
         let (mut header, mut state, mut components) = (None, None, None);
+        let (mut stream, mut labels) = (None, None);
         for m in msgs {
             match Address::parse(m.address) {
+                Some(Address::Stream) => stream = decode_stream(m.bytes).ok(),
+                Some(Address::Labels) => labels = decode_labels(m.bytes).ok(),
                 Some(Address::Frame) => header = decode_frame_into(m.bytes, &mut frame).ok(),
                 Some(Address::State) => state = decode_state(m.bytes).ok(),
                 Some(Address::Components) => {
@@ -167,6 +213,8 @@ where
         }
         let got = Received {
             at,
+            stream,
+            labels,
             frame: header.map(|h| (h, &frame)),
             state,
             components: components.map(|k| &u[..k]),

@@ -125,6 +125,11 @@ impl Source {
         self.to
     }
 
+    /// Its socket (to read what the daemon answers a source).
+    pub fn socket(&self) -> &UdpSocket {
+        &self.socket
+    }
+
     /// Sends the labels.
     pub fn send_labels(&mut self) {
         let result = self.socket.send_to(&self.labels, self.to);
@@ -194,7 +199,7 @@ impl Source {
     fn count(&mut self, result: std::io::Result<usize>) {
         if let Err(e) = result {
             if self.send_errors == 0 {
-                tracing::warn!(to = %self.to, error = %e, "send failed; counting further failures");
+                tracing::warn!(target: "emoshift", to = %self.to, error = %e, "send failed; counting further failures");
             }
             self.send_errors += 1;
         }

@@ -5,10 +5,11 @@
 
 pub mod analysis;
 pub mod edit;
+pub mod output;
 pub mod takes;
 pub mod training;
 
 pub use takes::{
-    load_inputs, load_model, load_session, load_take, match_take, project_take, resynthesise,
-    to_model_order, LoadedTake, ModelFrames, Projected,
+    load_inputs, load_model, load_model_limited, load_session, load_take, match_take, project_take,
+    resynthesise, set_input_limit, to_model_order, LoadedTake, ModelFrames, Projected,
 };

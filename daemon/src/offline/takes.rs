@@ -2,6 +2,7 @@
 //! model's marker order, projecting and resynthesising whole takes.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{bail, Context, Result};
 use ica_core::model::IcaModel;
@@ -21,12 +22,26 @@ pub struct LoadedTake {
     pub take: Take,
 }
 
-/// Loads a take, naming the file in the error; rejects an empty take.
+/// Largest input file the offline commands read, bytes (`--max-input-mb`).
+static INPUT_LIMIT: AtomicU64 = AtomicU64::new(replay::file::DEFAULT_MAX_TAKE_BYTES);
+
+/// Sets the largest input file (take, model, manifest) the offline commands read.
+pub fn set_input_limit(bytes: u64) {
+    INPUT_LIMIT.store(bytes, Ordering::Relaxed);
+}
+
+fn input_limit() -> u64 {
+    INPUT_LIMIT.load(Ordering::Relaxed)
+}
+
+/// Loads a take, naming the file in the error; rejects an empty take, a file that is not a
+/// regular one and a file over the input limit.
 ///
 /// # Errors
 /// Unreadable, malformed or empty file.
 pub fn load_take(path: &Path) -> Result<Take> {
-    let take = replay::load(path).with_context(|| format!("{}", path.display()))?;
+    let take =
+        replay::load_limited(path, input_limit()).with_context(|| format!("{}", path.display()))?;
     if take.n_frames() == 0 {
         bail!("{}: take has no frames", path.display());
     }
@@ -36,9 +51,17 @@ pub fn load_take(path: &Path) -> Result<Take> {
 /// Loads and validates a model file, naming the file in the error.
 ///
 /// # Errors
-/// Unreadable file, or not a valid model.
+/// Unreadable file, not a regular file, over the input limit, or not a valid model.
 pub fn load_model(path: &Path) -> Result<IcaModel> {
-    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    load_model_limited(path, input_limit())
+}
+
+/// [`load_model`] of a file of at most `max_bytes`.
+///
+/// # Errors
+/// As [`load_model`].
+pub fn load_model_limited(path: &Path, max_bytes: u64) -> Result<IcaModel> {
+    let file = replay::file::open_bounded(path, max_bytes)?;
     IcaModel::load(std::io::BufReader::new(file))
         .with_context(|| format!("{}: not a valid model", path.display()))
 }
@@ -48,7 +71,8 @@ pub fn load_model(path: &Path) -> Result<IcaModel> {
 /// # Errors
 /// Unreadable or invalid manifest.
 pub fn load_session(path: &Path) -> Result<Session> {
-    Session::load(path).with_context(|| format!("{}", path.display()))
+    // Its errors name the file already.
+    Ok(Session::load(path)?)
 }
 
 /// The input takes of a command: the manifest's takes, or the files given.

@@ -30,6 +30,8 @@ pub(crate) enum Command {
         path: PathBuf,
         /// The raw input's file.
         raw: Option<PathBuf>,
+        /// Replace files that exist.
+        overwrite: bool,
     },
     /// Stop recording.
     RecordStop,
@@ -53,6 +55,12 @@ pub(crate) enum Refusal {
     /// A model file could not be loaded.
     #[error("{0}")]
     Model(String),
+    /// The peer is not in `control_allow`.
+    #[error("control from {0} is not allowed (control_allow)")]
+    NotAllowed(std::net::IpAddr),
+    /// A mutating control without the shared secret.
+    #[error("this control needs the shared secret as its last argument")]
+    Secret,
     /// The processing thread did not take the command (queue full or stopped).
     #[error("the processing thread is busy or stopped")]
     Busy,
@@ -62,6 +70,23 @@ pub(crate) enum Refusal {
     /// The daemon is shutting down.
     #[error("shutting down")]
     ShuttingDown,
+}
+
+impl Refusal {
+    /// A refusal whose text is an error and all its causes, each once.
+    pub(crate) fn from_error(
+        make: fn(String) -> Refusal,
+        e: &(dyn std::error::Error + 'static),
+    ) -> Refusal {
+        let mut text = e.to_string();
+        let mut cause = e.source();
+        while let Some(c) = cause {
+            text.push_str(": ");
+            text.push_str(&c.to_string());
+            cause = c.source();
+        }
+        make(text)
+    }
 }
 
 /// The processing thread's answer to a [`Command`].

@@ -9,6 +9,8 @@ use std::time::Duration;
 use protocol::Profile;
 use serde::Deserialize;
 
+use super::allow::AllowList;
+
 pub use crate::engine::PerformerConfig;
 
 /// Default frame port.
@@ -22,6 +24,8 @@ pub const DEFAULT_QUEUE: usize = 64;
 pub const DEFAULT_POLL_WINDOW_US: u64 = 400;
 /// Default interval between status log lines.
 pub const DEFAULT_STATS_INTERVAL_S: f64 = 5.0;
+/// Default largest model file, MB: a 109-marker model is well under 1 MB.
+pub const DEFAULT_MAX_MODEL_MB: u64 = 256;
 
 /// One `[[performers]]` table.
 #[derive(Debug, Clone, Default, Deserialize, PartialEq)]
@@ -65,6 +69,16 @@ pub struct RawConfig {
     pub poll_window_us: Option<u64>,
     /// Seconds between status log lines.
     pub stats_interval_s: Option<f64>,
+    /// Seconds a `/subscribe` lasts unless renewed.
+    pub subscription_lease_s: Option<f64>,
+    /// Networks allowed on the control socket (CIDR); loopback only when absent.
+    pub control_allow: Option<Vec<String>>,
+    /// Networks allowed on the frame socket (CIDR); anyone when absent.
+    pub frames_allow: Option<Vec<String>>,
+    /// Shared secret that mutating control messages must carry as their last argument.
+    pub control_secret: Option<String>,
+    /// Largest model file `/model/load` and SIGHUP read, MB.
+    pub max_model_mb: Option<u64>,
     /// Named performers.
     pub performers: Vec<RawPerformer>,
 }
@@ -92,6 +106,16 @@ pub struct Config {
     pub poll_window: Duration,
     /// Status log interval.
     pub stats_interval: Duration,
+    /// How long a dynamic subscription lasts unless renewed.
+    pub lease: Duration,
+    /// Who may send control messages.
+    pub control_allow: AllowList,
+    /// Who may send frames.
+    pub frames_allow: AllowList,
+    /// The shared secret of mutating control messages, if any.
+    pub control_secret: Option<String>,
+    /// Largest model file read, bytes.
+    pub max_model_bytes: u64,
     /// Performers.
     pub performers: Vec<PerformerConfig>,
 }
@@ -99,9 +123,24 @@ pub struct Config {
 /// Why a configuration is refused; each names the key and the value.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ConfigError {
-    /// The TOML does not parse, or has an unknown key (toml names it).
-    #[error("{0}")]
-    Toml(String),
+    /// The TOML does not parse, has an unknown key or a value of the wrong type.
+    #[error("line {line}{}: {message}", key.as_ref().map(|k| format!(", key {k}")).unwrap_or_default())]
+    Toml {
+        /// 1-based line of the problem (0 when toml gives no place).
+        line: usize,
+        /// The key on that line, if it has one.
+        key: Option<String>,
+        /// What toml says.
+        message: String,
+    },
+    /// An allow-list entry that is not a network.
+    #[error("{key}: {message}")]
+    Network {
+        /// Key.
+        key: &'static str,
+        /// Why.
+        message: String,
+    },
     /// An address that does not parse.
     #[error("{key}: {value:?} is not an IP:PORT address")]
     Address {
@@ -135,9 +174,25 @@ impl RawConfig {
     /// Parses a TOML text.
     ///
     /// # Errors
-    /// [`ConfigError::Toml`] with toml's message, which names an unknown key.
+    /// [`ConfigError::Toml`] naming the line, the key and what is wrong (an unknown key, a
+    /// value of the wrong type, broken syntax).
     pub fn from_toml(text: &str) -> Result<RawConfig, ConfigError> {
-        toml::from_str(text).map_err(|e| ConfigError::Toml(e.message().to_string()))
+        toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |s| {
+                text[..s.start.min(text.len())].lines().count().max(1)
+            });
+            let key = (line > 0)
+                .then(|| text.lines().nth(line - 1))
+                .flatten()
+                .and_then(|l| l.split_once('='))
+                .map(|(k, _)| k.trim().to_string())
+                .filter(|k| !k.is_empty());
+            ConfigError::Toml {
+                line,
+                key,
+                message: e.message().trim().to_string(),
+            }
+        })
     }
 
     /// Checks every value once.
@@ -145,76 +200,18 @@ impl RawConfig {
     /// # Errors
     /// The first bad value, named.
     pub fn validate(self) -> Result<Config, ConfigError> {
-        let addr = |key: &'static str, v: Option<String>, default: &str| {
-            let v = v.unwrap_or_else(|| default.to_string());
-            v.parse::<SocketAddr>()
-                .map_err(|_| ConfigError::Address { key, value: v })
-        };
-        let range = |key, ok: bool, value: String, range| {
-            if ok {
-                Ok(())
-            } else {
-                Err(ConfigError::Range { key, value, range })
-            }
-        };
-        let lowpass_s = self
-            .lowpass_s
-            .unwrap_or(crate::engine::edit_state::DEFAULT_LOWPASS_S);
-        range(
-            "lowpass_s",
-            lowpass_s.is_finite() && lowpass_s >= 0.0,
-            lowpass_s.to_string(),
-            ">= 0",
-        )?;
-        let queue = self.queue.unwrap_or(DEFAULT_QUEUE);
-        range(
-            "queue",
-            (1..=65_536).contains(&queue),
-            queue.to_string(),
-            "1..=65536",
-        )?;
-        let poll_window_us = self.poll_window_us.unwrap_or(DEFAULT_POLL_WINDOW_US);
-        range(
-            "poll_window_us",
-            poll_window_us <= 1_000,
-            poll_window_us.to_string(),
-            "0..=1000",
-        )?;
-        let stats = self.stats_interval_s.unwrap_or(DEFAULT_STATS_INTERVAL_S);
-        range(
-            "stats_interval_s",
-            stats.is_finite() && stats > 0.0,
-            stats.to_string(),
-            "> 0",
-        )?;
+        let numbers = self.numbers()?;
         let send = self
             .send
             .iter()
             .map(|s| parse_send(s))
             .collect::<Result<_, _>>()?;
-        let performers = self
-            .performers
-            .into_iter()
-            .map(|p| {
-                let source = p
-                    .source
-                    .map(|s| {
-                        s.parse().map_err(|_| ConfigError::Address {
-                            key: "performers.source",
-                            value: s,
-                        })
-                    })
-                    .transpose()?;
-                Ok(PerformerConfig {
-                    name: p.name,
-                    model: p.model,
-                    source,
-                    layout: p.layout,
-                    target: p.emotion,
-                    amount: p.amount,
-                })
-            })
-            .collect::<Result<_, ConfigError>>()?;
+        let allow = |key, list: Option<Vec<String>>, default: AllowList| match list {
+            Some(l) => {
+                AllowList::parse(&l).map_err(|message| ConfigError::Network { key, message })
+            }
+            None => Ok(default),
+        };
         Ok(Config {
             listen: addr("listen", self.listen, DEFAULT_LISTEN)?,
             control: addr("control", self.control, DEFAULT_CONTROL)?,
@@ -226,13 +223,136 @@ impl RawConfig {
             max_send_failures: self
                 .max_send_failures
                 .unwrap_or(crate::engine::clients::DEFAULT_MAX_FAILURES),
-            lowpass_s,
-            queue,
-            poll_window: Duration::from_micros(poll_window_us),
-            stats_interval: Duration::from_secs_f64(stats),
-            performers,
+            lowpass_s: numbers.lowpass_s,
+            queue: numbers.queue,
+            poll_window: numbers.poll_window,
+            stats_interval: numbers.stats_interval,
+            lease: numbers.lease,
+            control_allow: allow("control_allow", self.control_allow, AllowList::loopback())?,
+            frames_allow: allow("frames_allow", self.frames_allow, AllowList::anyone())?,
+            control_secret: secret(self.control_secret)?,
+            max_model_bytes: numbers.max_model_bytes,
+            performers: self
+                .performers
+                .into_iter()
+                .map(performer)
+                .collect::<Result<_, _>>()?,
         })
     }
+
+    /// The numeric keys, each checked against its range.
+    fn numbers(&self) -> Result<Numbers, ConfigError> {
+        let lowpass_s = self
+            .lowpass_s
+            .unwrap_or(crate::engine::edit_state::DEFAULT_LOWPASS_S);
+        check(
+            "lowpass_s",
+            lowpass_s.is_finite() && lowpass_s >= 0.0,
+            lowpass_s,
+            ">= 0",
+        )?;
+        let queue = self.queue.unwrap_or(DEFAULT_QUEUE);
+        check("queue", (1..=65_536).contains(&queue), queue, "1..=65536")?;
+        let poll_us = self.poll_window_us.unwrap_or(DEFAULT_POLL_WINDOW_US);
+        check("poll_window_us", poll_us <= 1_000, poll_us, "0..=1000")?;
+        let stats = self.stats_interval_s.unwrap_or(DEFAULT_STATS_INTERVAL_S);
+        check(
+            "stats_interval_s",
+            stats.is_finite() && stats > 0.0,
+            stats,
+            "> 0",
+        )?;
+        let lease = self
+            .subscription_lease_s
+            .unwrap_or(crate::engine::clients::DEFAULT_LEASE.as_secs_f64());
+        let ok = lease.is_finite() && (1.0..=3_600.0).contains(&lease);
+        check("subscription_lease_s", ok, lease, "1..=3600")?;
+        let mb = self.max_model_mb.unwrap_or(DEFAULT_MAX_MODEL_MB);
+        check("max_model_mb", (1..=65_536).contains(&mb), mb, "1..=65536")?;
+        Ok(Numbers {
+            lowpass_s,
+            queue,
+            poll_window: Duration::from_micros(poll_us),
+            stats_interval: Duration::from_secs_f64(stats),
+            lease: Duration::from_secs_f64(lease),
+            max_model_bytes: mb << 20,
+        })
+    }
+}
+
+/// The numeric settings, checked.
+struct Numbers {
+    lowpass_s: f32,
+    queue: usize,
+    poll_window: Duration,
+    stats_interval: Duration,
+    lease: Duration,
+    max_model_bytes: u64,
+}
+
+fn check(
+    key: &'static str,
+    ok: bool,
+    value: impl std::fmt::Display,
+    range: &'static str,
+) -> Result<(), ConfigError> {
+    match ok {
+        true => Ok(()),
+        false => Err(ConfigError::Range {
+            key,
+            value: value.to_string(),
+            range,
+        }),
+    }
+}
+
+fn addr(key: &'static str, v: Option<String>, default: &str) -> Result<SocketAddr, ConfigError> {
+    let v = v.unwrap_or_else(|| default.to_string());
+    v.parse::<SocketAddr>()
+        .map_err(|_| ConfigError::Address { key, value: v })
+}
+
+fn secret(s: Option<String>) -> Result<Option<String>, ConfigError> {
+    match s {
+        Some(s) if s.is_empty() || s.len() > protocol::MAX_NAME_BYTES || s.contains('\0') => {
+            Err(ConfigError::Range {
+                key: "control_secret",
+                value: format!("of {} bytes", s.len()),
+                range: "1 to 256 bytes, no NUL",
+            })
+        }
+        other => Ok(other),
+    }
+}
+
+fn performer(p: RawPerformer) -> Result<PerformerConfig, ConfigError> {
+    let source = p
+        .source
+        .map(|s| {
+            s.parse().map_err(|_| ConfigError::Address {
+                key: "performers.source",
+                value: s,
+            })
+        })
+        .transpose()?;
+    if let Some(a) = p.amount {
+        check("performers.amount", (0.0..=1.0).contains(&a), a, "0..=1")?;
+    }
+    let name_ok = !p.name.is_empty() && p.name.len() <= protocol::MAX_STREAM_NAME_BYTES;
+    check(
+        "performers.name",
+        name_ok,
+        format!("{:?}", p.name),
+        "1 to 64 bytes",
+    )?;
+    Ok(PerformerConfig {
+        name: p.name,
+        model: p.model,
+        source,
+        layout: p.layout,
+        target: p.emotion,
+        amount: p.amount,
+    })
 }
 
 /// Parses `HOST:PORT[:profile]` (IPv6 as `[::1]:PORT[:profile]`); compact by default.
@@ -258,66 +378,5 @@ pub fn parse_send(text: &str) -> Result<(SocketAddr, Profile), ConfigError> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn defaults_bind_loopback_and_unknown_keys_are_named() {
-        let c = RawConfig::from_toml("model = \"m.json\"")
-            .expect("valid")
-            .validate()
-            .expect("valid");
-        assert!(c.listen.ip().is_loopback() && c.control.ip().is_loopback());
-        assert_eq!(c.max_subscribers, 16);
-        let e = RawConfig::from_toml("model = \"m.json\"\nlisten_port = 3").expect_err("unknown");
-        assert!(e.to_string().contains("listen_port"), "{e}");
-    }
-
-    #[test]
-    fn the_example_config_parses_and_holds_the_defaults() {
-        let text = include_str!("../../../docs/emoshift.toml");
-        let c = RawConfig::from_toml(text)
-            .expect("the example parses")
-            .validate()
-            .expect("the example is valid");
-        let d = RawConfig {
-            model: Some("model.json".into()),
-            ..RawConfig::default()
-        };
-        assert_eq!(c, d.validate().expect("defaults are valid"));
-    }
-
-    #[test]
-    fn send_entries_take_a_profile_and_bad_values_are_named() {
-        assert_eq!(
-            parse_send("239.0.0.1:9100:flat-split"),
-            Ok(("239.0.0.1:9100".parse().expect("addr"), Profile::FlatSplit))
-        );
-        assert_eq!(parse_send("[::1]:9100").map(|s| s.1), Ok(Profile::Compact));
-        assert!(matches!(
-            parse_send("127.0.0.1:9:loud"),
-            Err(ConfigError::Profile { .. })
-        ));
-        let raw = RawConfig {
-            model: Some("m".into()),
-            lowpass_s: Some(-1.0),
-            ..RawConfig::default()
-        };
-        assert!(raw
-            .validate()
-            .expect_err("negative")
-            .to_string()
-            .contains("lowpass_s"));
-        let raw = RawConfig {
-            model: Some("m".into()),
-            poll_window_us: Some(5_000),
-            ..RawConfig::default()
-        };
-        assert!(raw
-            .validate()
-            .expect_err("a 5 ms window would poll most of the period")
-            .to_string()
-            .contains("poll_window_us"));
-        assert_eq!(RawConfig::default().validate(), Err(ConfigError::NoModel));
-    }
-}
+#[path = "config_tests.rs"]
+mod tests;

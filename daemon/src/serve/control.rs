@@ -11,7 +11,7 @@ use std::time::Duration;
 use crossbeam_channel::Sender;
 use ica_core::model::IcaModel;
 use protocol::{
-    decode_control, encode_confirm_into, encode_emotion_list_into, encode_error_into,
+    encode_challenge_into, encode_confirm_into, encode_emotion_list_into, encode_error_into,
     encode_status_into, Control, EmotionList,
 };
 use tokio::net::UdpSocket;
@@ -20,6 +20,7 @@ use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
 use super::command::{Command, Refusal, Reply, Request};
+pub(crate) use super::guard::Guard;
 use super::stats::Stats;
 
 /// How long a control message waits for the processing thread's answer.
@@ -35,6 +36,8 @@ pub(crate) struct ControlCtx {
     /// The default model now (for `/emotion/list`).
     pub(crate) model: Arc<Mutex<Arc<IcaModel>>>,
     pub(crate) tracker: TaskTracker,
+    /// Who may control, and how.
+    pub(crate) guard: Arc<Guard>,
 }
 
 /// Serves the control socket until shutdown.
@@ -46,20 +49,31 @@ pub(crate) async fn run(ctx: ControlCtx, shutdown: CancellationToken) {
             r = ctx.socket.recv_from(&mut buf) => match r {
                 Ok(r) => r,
                 Err(e) => {
-                    tracing::trace!(error = %e, "control socket receive error");
+                    tracing::trace!(target: "emoshift", error = %e, "control socket receive error");
                     continue;
                 }
             },
         };
-        let control = match decode_control(&buf[..len]) {
+        let control = match ctx
+            .guard
+            .admit(peer)
+            .and_then(|()| ctx.guard.decode(&buf[..len]))
+        {
             Ok(c) => c,
-            Err(e) => {
-                tracing::debug!(%peer, error = %e, "refused control message");
+            Err(refusal) => {
                 let address = refused_address(&buf[..len]);
-                reply(&ctx, peer, &address, Err(Refusal::Invalid(e.to_string()))).await;
+                reply(&ctx, peer, &address, Err(refusal)).await;
                 continue;
             }
         };
+        if let Err(cookie) = ctx.guard.check_cookie(peer, &control) {
+            // From beyond loopback a subscription starts only when the requester proves it
+            // receives at its address: a spoofed source never sees the cookie.
+            let mut out = Vec::with_capacity(64);
+            encode_challenge_into(cookie, &mut out);
+            send(&ctx, peer, &out).await;
+            continue;
+        }
         if let Control::ModelLoad(path) = &control {
             // Loading may take a while: answer from its own task, keep serving.
             let (ctx2, path) = (ctx.clone(), PathBuf::from(path));
@@ -140,13 +154,18 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
             )
             .await
         }
-        Control::RecordStart { path, raw } => {
+        Control::RecordStart {
+            path,
+            raw,
+            overwrite,
+        } => {
             let raw = raw.as_ref().map(PathBuf::from);
             ask(
                 ctx,
                 Command::RecordStart {
                     path: PathBuf::from(path),
                     raw,
+                    overwrite: *overwrite,
                 },
             )
             .await
@@ -176,7 +195,7 @@ async fn ask(ctx: &ControlCtx, command: Command) -> Reply {
 /// Loads and validates a model on a blocking thread, then swaps it in at a frame boundary. A
 /// bad file leaves the old model running.
 async fn reload(ctx: &ControlCtx, path: PathBuf) -> Reply {
-    let model = super::load_model(path.clone())
+    let model = super::load_model(path.clone(), ctx.guard.max_model_bytes)
         .await
         .map_err(|e| Refusal::Model(format!("{e:#}")))?;
     let model = Arc::new(model);
@@ -187,7 +206,10 @@ async fn reload(ctx: &ControlCtx, path: PathBuf) -> Reply {
     if let Ok(mut m) = ctx.model.lock() {
         *m = model;
     }
-    tracing::info!(path = %path.display(), "model swapped in");
+    if let Ok(mut s) = ctx.stats.lock() {
+        s.model = path.display().to_string();
+    }
+    tracing::info!(target: "emoshift", path = %path.display(), "model swapped in");
     Ok(())
 }
 
@@ -200,7 +222,10 @@ async fn confirm(ctx: &ControlCtx, peer: SocketAddr, control: &Control) {
 /// Sends the error reply of a refused message (`Ok` sends nothing).
 async fn reply(ctx: &ControlCtx, peer: SocketAddr, address: &str, r: Reply) {
     let Err(e) = r else { return };
-    tracing::debug!(%peer, address, error = %e, "control refused");
+    if let Ok(mut s) = ctx.stats.lock() {
+        s.control_refused += 1;
+    }
+    ctx.guard.warn_refused(peer, address, &e);
     let mut out = Vec::with_capacity(256);
     encode_error_into(address, &e.to_string(), &mut out);
     send(ctx, peer, &out).await;
@@ -208,7 +233,7 @@ async fn reply(ctx: &ControlCtx, peer: SocketAddr, address: &str, r: Reply) {
 
 async fn send(ctx: &ControlCtx, peer: SocketAddr, bytes: &[u8]) {
     if let Err(e) = ctx.socket.send_to(bytes, peer).await {
-        tracing::debug!(%peer, error = %e, "control reply not sent");
+        tracing::debug!(target: "emoshift", %peer, error = %e, "control reply not sent");
     }
 }
 
@@ -218,7 +243,7 @@ pub(crate) async fn reload_on_sighup(ctx: ControlCtx, shutdown: CancellationToke
     {
         use tokio::signal::unix::{signal, SignalKind};
         let Ok(mut hup) = signal(SignalKind::hangup()) else {
-            tracing::warn!("cannot listen for SIGHUP; reload with /model/load");
+            tracing::warn!(target: "emoshift", "cannot listen for SIGHUP; reload with /model/load");
             return;
         };
         loop {
@@ -229,7 +254,7 @@ pub(crate) async fn reload_on_sighup(ctx: ControlCtx, shutdown: CancellationToke
                     let Some(path) = path else { continue };
                     match reload(&ctx, path).await {
                         Ok(()) => {}
-                        Err(e) => tracing::warn!(error = %e, "SIGHUP reload failed, old model kept"),
+                        Err(e) => tracing::warn!(target: "emoshift", error = %e, "SIGHUP reload failed, old model kept"),
                     }
                 }
             }

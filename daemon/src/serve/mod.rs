@@ -17,10 +17,12 @@
 //! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
 //! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).
 
+pub mod allow;
 pub mod arrival;
 mod command;
 pub mod config;
 mod control;
+mod guard;
 pub mod net;
 mod processing;
 pub mod record;
@@ -44,12 +46,12 @@ pub async fn run(config: Config, shutdown: CancellationToken) -> anyhow::Result<
     bind(config).await?.run(shutdown).await
 }
 
-/// Loads a model file on a blocking thread.
+/// Loads a model file of at most `max_bytes` on a blocking thread.
 ///
 /// # Errors
-/// Unreadable or invalid file, named.
-pub async fn load_model(path: std::path::PathBuf) -> anyhow::Result<IcaModel> {
-    tokio::task::spawn_blocking(move || crate::offline::load_model(&path))
+/// Unreadable, not a regular file, too large or invalid, named.
+pub async fn load_model(path: std::path::PathBuf, max_bytes: u64) -> anyhow::Result<IcaModel> {
+    tokio::task::spawn_blocking(move || crate::offline::load_model_limited(&path, max_bytes))
         .await
         .context("model loader panicked")?
 }

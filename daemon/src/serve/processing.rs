@@ -3,7 +3,9 @@
 //! recording; counters merged into the shared [`Stats`] between bursts. While its queue is
 //! empty it parks, or polls around a steady source's next expected frame ([`ArrivalClock`]).
 
+use std::collections::HashMap;
 use std::net::SocketAddr;
+use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -12,10 +14,10 @@ use crossbeam_channel::{Receiver, Sender};
 
 use super::arrival::{ArrivalClock, SpinWindow, Wait};
 use super::command::{Command, Refusal, Reply, Request};
-use super::record::Recording;
+use super::record::{close_in_background, finish_recording, RecordError, Recording};
 use super::sender::Fanout;
-use super::stats::Stats;
-use crate::engine::pipeline::{Emitted, Pipeline};
+use super::stats::{Stats, SubscriberStatus};
+use crate::engine::pipeline::{Emitted, Pipeline, Refusal as Refused};
 
 /// The processing thread merges its counters and histograms into the shared [`Stats`] (a
 /// lock, a histogram add and reset: tens of µs) only between bursts, at most this often: with
@@ -27,6 +29,8 @@ const MERGE_EVERY: Duration = Duration::from_millis(100);
 const MERGE_AT_LEAST: Duration = Duration::from_secs(1);
 /// Time to spare before the next tick for a merge.
 const QUIET: Duration = Duration::from_millis(2);
+/// A source hears why its datagram was refused at most this often.
+const TELL_EVERY: Duration = Duration::from_secs(1);
 /// The processing thread parks at most this long between two looks at its counters.
 const IDLE: Duration = Duration::from_millis(50);
 /// One received datagram.
@@ -53,6 +57,10 @@ pub(crate) struct Shared {
     pub(crate) stats: Arc<Mutex<Stats>>,
     /// Frames the receive task dropped because the queue was full.
     pub(crate) queue_dropped: Arc<AtomicU64>,
+    /// Frames the receive task dropped because their source is not allowed.
+    pub(crate) not_allowed: Arc<AtomicU64>,
+    /// The frame socket, to tell a source why its datagram was refused (`None` in tests).
+    pub(crate) replies: Option<std::net::UdpSocket>,
 }
 
 /// What the processing thread does while its queue is empty.
@@ -79,6 +87,10 @@ pub(crate) struct Processing {
     cmd_rx: Receiver<Request>,
     stats: Arc<Mutex<Stats>>,
     queue_dropped: Arc<AtomicU64>,
+    not_allowed: Arc<AtomicU64>,
+    /// The frame socket, for refusals a source should hear, and when each source last heard one.
+    replies: Option<std::net::UdpSocket>,
+    told: HashMap<SocketAddr, Instant>,
     recording: Option<Recording>,
     /// Recordings being closed on their own threads.
     closing: Vec<std::thread::JoinHandle<()>>,
@@ -110,6 +122,9 @@ impl Processing {
             cmd_rx: channels.commands,
             stats: shared.stats,
             queue_dropped: shared.queue_dropped,
+            not_allowed: shared.not_allowed,
+            replies: shared.replies,
+            told: HashMap::new(),
             recording: None,
             closing: Vec::new(),
             last_merge: Instant::now(),
@@ -245,7 +260,32 @@ impl Processing {
         if clients_changed {
             self.pipeline.set_wanted(self.fanout.wanted());
         }
+        if let Some(refusal) = self.pipeline.take_refusal() {
+            self.tell_source(&refusal);
+        }
         let _ = self.free_tx.try_send(frame.bytes);
+    }
+
+    /// Sends `/emoshift/error` to a source whose datagram was refused, at most once a second
+    /// per source (a spoofed source cannot turn the daemon into a reflector).
+    fn tell_source(&mut self, refusal: &Refused) {
+        let now = Instant::now();
+        if self
+            .told
+            .get(&refusal.to)
+            .is_some_and(|t| now.duration_since(*t) < TELL_EVERY)
+        {
+            return;
+        }
+        if self.told.len() >= 256 {
+            self.told.retain(|_, t| now.duration_since(*t) < TELL_EVERY);
+        }
+        self.told.insert(refusal.to, now);
+        tracing::warn!(target: "emoshift", source = %refusal.to, why = %refusal.why, "datagram refused");
+        let Some(socket) = &self.replies else { return };
+        let mut out = Vec::with_capacity(256);
+        protocol::encode_error_into(protocol::address::LABELS, &refusal.why, &mut out);
+        let _ = socket.send_to(&out, refusal.to);
     }
 
     /// Between frames: subscriptions whose lease ended; recordings done closing.
@@ -260,6 +300,21 @@ impl Processing {
         let Ok(mut s) = self.stats.lock() else { return };
         s.counters = self.pipeline.counters.clone();
         s.counters.dropped_queue_full = self.queue_dropped.load(Ordering::Relaxed);
+        s.dropped_not_allowed = self.not_allowed.load(Ordering::Relaxed);
+        let now = Instant::now();
+        s.subscribers = self
+            .fanout
+            .subscribers()
+            .map(|c| SubscriberStatus {
+                addr: c.addr,
+                profile: c.profile,
+                performer: c.performer.clone(),
+                lease_ms: c.lease_left(now).map(|d| d.as_millis() as u64),
+                sends: c.sends,
+                failures: c.failures_total,
+                backing_off: c.is_backing_off(),
+            })
+            .collect();
         s.streams = self.pipeline.stream_count() as u64;
         s.per_stream = self.pipeline.stream_status();
         s.send = self.fanout.counters.clone();
@@ -285,19 +340,17 @@ impl Processing {
                 self.pipeline.set_wanted(self.fanout.wanted());
                 Some(r.map_err(Refusal::Client))
             }
-            Command::SetModel(model) => {
-                self.pipeline.set_model(model);
-                Some(Ok(()))
-            }
-            Command::RecordStart { path, raw } => {
-                // The new recording is checked first: a bad path leaves the old one running.
-                let r = Recording::start(&path, raw.as_deref()).map(|rec| {
-                    if let Some(old) = self.recording.replace(rec) {
-                        self.closing.push(close_in_background(old, None));
-                    }
-                });
-                Some(r.map_err(|e| Refusal::Record(e.to_string())))
-            }
+            Command::SetModel(model) => Some(
+                self.pipeline
+                    .check_model(&model)
+                    .map(|()| self.pipeline.set_model(model))
+                    .map_err(|e| Refusal::Model(e.to_string())),
+            ),
+            Command::RecordStart {
+                path,
+                raw,
+                overwrite,
+            } => Some(self.record_start(&path, raw.as_deref(), overwrite)),
             Command::RecordStop => match self.recording.take() {
                 Some(rec) => {
                     // Answered by the closing thread once the files are complete.
@@ -313,28 +366,22 @@ impl Processing {
     }
 }
 
-fn finish_recording(rec: Recording) {
-    if let Err(e) = rec.finish() {
-        tracing::warn!(error = %e, "recording failed");
+impl Processing {
+    /// Starts a recording: refused while one runs to the same path; one running to another
+    /// path is closed once the new one is ready (a bad new path leaves it running).
+    fn record_start(&mut self, path: &Path, raw: Option<&Path>, overwrite: bool) -> Reply {
+        let refused = |e: RecordError| Refusal::from_error(Refusal::Record, &e);
+        if let Some(running) = &self.recording {
+            if running.writes_to(path) {
+                let path = path.display().to_string();
+                return Err(refused(RecordError::Running { path }));
+            }
+        }
+        let rec = Recording::start(path, raw, overwrite).map_err(refused)?;
+        if let Some(old) = self.recording.replace(rec) {
+            tracing::info!(target: "emoshift", to = %path.display(), "recording closed for a new one");
+            self.closing.push(close_in_background(old, None));
+        }
+        Ok(())
     }
-}
-
-/// Closes a recording on its own thread (each file ends with an fsync, which must not hold up
-/// the frames), answering `reply` when done.
-fn close_in_background(
-    rec: Recording,
-    reply: Option<tokio::sync::oneshot::Sender<Reply>>,
-) -> std::thread::JoinHandle<()> {
-    std::thread::spawn(move || {
-        let r = rec
-            .finish()
-            .map(|_| ())
-            .map_err(|e| Refusal::Record(e.to_string()));
-        if let Err(e) = &r {
-            tracing::warn!(error = %e, "recording failed");
-        }
-        if let Some(reply) = reply {
-            let _ = reply.send(r);
-        }
-    })
 }

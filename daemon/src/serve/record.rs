@@ -34,8 +34,20 @@ pub enum RecordError {
         /// The path given twice.
         path: String,
     },
+    /// The file exists and overwriting was not asked for.
+    #[error("{path} exists; give overwrite (a last int 1) to replace it")]
+    Exists {
+        /// The path.
+        path: String,
+    },
+    /// A recording to this path is running.
+    #[error("already recording to {path}; /record/stop first, or start one with a new path")]
+    Running {
+        /// The path.
+        path: String,
+    },
     /// The file cannot be created or written.
-    #[error("{path}: {source}")]
+    #[error("{path}")]
     Io {
         /// The path.
         path: String,
@@ -93,7 +105,7 @@ impl Sink {
                 Err(e) => return self.fail(&e),
             }
         } else if lost > MAX_FILL {
-            tracing::warn!(path = %self.path.display(), lost, "long pause not filled");
+            tracing::warn!(target: "emoshift", path = %self.path.display(), lost, "long pause not filled");
         } else {
             for _ in 0..lost {
                 if let Some(Err(e)) = self
@@ -111,7 +123,7 @@ impl Sink {
     }
 
     fn fail(&mut self, e: &replay::WriteError) {
-        tracing::warn!(path = %self.path.display(), error = %e, "recording stopped");
+        tracing::warn!(target: "emoshift", path = %self.path.display(), error = %e, "recording stopped");
         self.error = Some(e.to_string());
     }
 
@@ -125,7 +137,7 @@ impl Sink {
             Some(r) => r.finish().map_err(|e| write_error(e.to_string()))?.frames,
             None => 0,
         };
-        tracing::info!(path = %self.path.display(), frames, "recording closed");
+        tracing::info!(target: "emoshift", path = %self.path.display(), frames, "recording closed");
         match self.error {
             Some(e) => Err(write_error(format!("stopped after {frames} frames: {e}"))),
             None => Ok(frames),
@@ -153,6 +165,8 @@ impl StreamFiles {
 #[derive(Debug)]
 pub struct Recording {
     path: PathBuf,
+    /// Files that exist may be replaced.
+    overwrite: bool,
     raw: Option<PathBuf>,
     /// Files of streams still recording.
     streams: Vec<StreamFiles>,
@@ -212,11 +226,16 @@ pub fn stream_path(path: &Path, k: usize) -> PathBuf {
 }
 
 impl Recording {
-    /// Checks both paths (extension, distinct, can be created).
+    /// Checks both paths (extension, distinct, not there unless `overwrite`, can be created).
     ///
     /// # Errors
-    /// [`RecordError::Extension`], [`RecordError::SamePath`] or [`RecordError::Io`].
-    pub fn start(path: &Path, raw: Option<&Path>) -> Result<Recording, RecordError> {
+    /// [`RecordError::Extension`], [`RecordError::SamePath`], [`RecordError::Exists`] or
+    /// [`RecordError::Io`].
+    pub fn start(
+        path: &Path,
+        raw: Option<&Path>,
+        overwrite: bool,
+    ) -> Result<Recording, RecordError> {
         if raw.is_some_and(|raw| absolute(raw) == absolute(path)) {
             return Err(RecordError::SamePath {
                 path: path.display().to_string(),
@@ -225,12 +244,27 @@ impl Recording {
         // Every check before any file is created, so a refused start truncates nothing.
         check_extension(path)?;
         raw.map(check_extension).transpose()?;
+        for p in std::iter::once(path).chain(raw) {
+            // Opening a FIFO or a device to write would block or never end.
+            if std::fs::metadata(p).is_ok_and(|m| !m.is_file()) {
+                return Err(RecordError::Io {
+                    path: p.display().to_string(),
+                    source: std::io::Error::other("not a regular file"),
+                });
+            }
+            if !overwrite && p.exists() {
+                return Err(RecordError::Exists {
+                    path: p.display().to_string(),
+                });
+            }
+        }
         if let Some(raw) = raw {
             check_creatable(raw)?;
         }
         check_creatable(path)?;
         Ok(Recording {
             path: path.to_path_buf(),
+            overwrite,
             raw: raw.map(Path::to_path_buf),
             streams: Vec::new(),
             retired: Vec::new(),
@@ -240,12 +274,17 @@ impl Recording {
         })
     }
 
+    /// Whether this recording writes to `path` (its edited stream's first file).
+    pub fn writes_to(&self, path: &Path) -> bool {
+        absolute(path) == absolute(&self.path)
+    }
+
     /// Appends one processed frame to its stream's files (opened on the stream's first frame).
     pub fn push(&mut self, e: &Emitted<'_>) {
         let i = match self.streams.iter().position(|s| s.key == e.key) {
             Some(i) if self.streams[i].fits(e) => i,
             Some(i) => {
-                tracing::info!(source = %e.key.source, "labels changed: recording to new files");
+                tracing::info!(target: "emoshift", source = %e.key.source, "labels changed: recording to new files");
                 let old = self.streams.swap_remove(i);
                 self.retired.push(old);
                 self.open(e)
@@ -279,7 +318,9 @@ impl Recording {
         loop {
             let p = stream_path(base, k);
             let abs = absolute(&p);
-            if !self.taken.contains(&abs) {
+            // The first file was checked at start; later ones skip what is already on disk.
+            let on_disk = k > 1 && !self.overwrite && p.exists();
+            if !self.taken.contains(&abs) && !on_disk {
                 self.taken.push(abs);
                 return p;
             }
@@ -293,6 +334,7 @@ impl Recording {
         let edited = self.free_path(&self.path.clone());
         let raw = self.raw.clone().map(|p| self.free_path(&p));
         tracing::info!(
+            target: "emoshift",
             source = %key.source,
             layout = key.layout_id,
             edited = %edited.display(),
@@ -327,6 +369,32 @@ impl Recording {
         }
         first_error.map_or(Ok(frames), Err)
     }
+}
+
+pub(crate) fn finish_recording(rec: Recording) {
+    if let Err(e) = rec.finish() {
+        tracing::warn!(target: "emoshift", error = %e, "recording failed");
+    }
+}
+
+/// Closes a recording on its own thread (each file ends with an fsync, which must not hold up
+/// the frames), answering `reply` when done.
+pub(crate) fn close_in_background(
+    rec: Recording,
+    reply: Option<tokio::sync::oneshot::Sender<super::command::Reply>>,
+) -> std::thread::JoinHandle<()> {
+    std::thread::spawn(move || {
+        let r = rec
+            .finish()
+            .map(|_| ())
+            .map_err(|e| super::command::Refusal::from_error(super::command::Refusal::Record, &e));
+        if let Err(e) = &r {
+            tracing::warn!(target: "emoshift", error = %e, "recording failed");
+        }
+        if let Some(reply) = reply {
+            let _ = reply.send(r);
+        }
+    })
 }
 
 #[cfg(test)]

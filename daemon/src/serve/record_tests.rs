@@ -1,6 +1,7 @@
 use std::net::SocketAddr;
 
 use super::*;
+use crate::engine::stream::Identity;
 
 #[test]
 fn later_streams_get_numbered_files_beside_the_first() {
@@ -18,18 +19,23 @@ fn bad_paths_are_refused_at_start() {
     let dir = tempfile::tempdir().expect("temp dir");
     let ok = dir.path().join("a.csv");
     assert!(matches!(
-        Recording::start(&dir.path().join("a.txt"), None),
+        Recording::start(&dir.path().join("a.txt"), None, false),
         Err(RecordError::Extension { .. })
     ));
     assert!(matches!(
-        Recording::start(&ok, Some(&ok)),
+        Recording::start(&ok, Some(&ok), false),
         Err(RecordError::SamePath { .. })
     ));
     assert!(matches!(
-        Recording::start(&ok, Some(&dir.path().join("missing/raw.c3d"))),
+        Recording::start(&ok, Some(&dir.path().join("missing/raw.c3d")), false),
         Err(RecordError::Io { .. })
     ));
-    assert!(Recording::start(&ok, Some(&dir.path().join("raw.trc"))).is_ok());
+    assert!(Recording::start(&ok, Some(&dir.path().join("raw.trc")), false).is_ok());
+}
+
+fn identity() -> &'static Identity {
+    static ID: std::sync::OnceLock<Identity> = std::sync::OnceLock::new();
+    ID.get_or_init(|| Identity::new(0, "test"))
 }
 
 fn emitted<'a>(
@@ -41,6 +47,9 @@ fn emitted<'a>(
 ) -> Emitted<'a> {
     Emitted {
         key,
+        identity: identity(),
+        labels_msg: &[],
+        labels_due: false,
         frame_number: n,
         frames_since_last: 1,
         compact: &[],
@@ -59,7 +68,7 @@ fn emitted<'a>(
 fn two_performers_are_recorded_to_their_own_files_never_mixed() {
     let dir = tempfile::tempdir().expect("temp dir");
     let (edited, raw) = (dir.path().join("take.csv"), dir.path().join("in.csv"));
-    let mut rec = Recording::start(&edited, Some(&raw)).expect("paths are fine");
+    let mut rec = Recording::start(&edited, Some(&raw), false).expect("paths are fine");
     let labels: Vec<String> = vec!["a".into(), "b".into()];
     let key = |port| StreamKey {
         source: SocketAddr::from(([127, 0, 0, 1], port)),
@@ -99,7 +108,7 @@ fn key(port: u16) -> StreamKey {
 fn numbered_names_never_collide_with_the_paths_given() {
     let dir = tempfile::tempdir().expect("temp dir");
     let (edited, raw) = (dir.path().join("take.csv"), dir.path().join("take.2.csv"));
-    let mut rec = Recording::start(&edited, Some(&raw)).expect("paths are fine");
+    let mut rec = Recording::start(&edited, Some(&raw), false).expect("paths are fine");
     let labels: Vec<String> = vec!["a".into()];
     let mut input = protocol::FrameBuf::with_max_markers(1);
     for (k, port) in [(1.0, 7000), (2.0, 7001)] {
@@ -124,7 +133,7 @@ fn numbered_names_never_collide_with_the_paths_given() {
 fn lost_frames_become_gaps_and_new_labels_a_new_file() {
     let dir = tempfile::tempdir().expect("temp dir");
     let path = dir.path().join("take.csv");
-    let mut rec = Recording::start(&path, None).expect("path is fine");
+    let mut rec = Recording::start(&path, None, false).expect("path is fine");
     let (one, two): (Vec<String>, Vec<String>) = (vec!["a".into()], vec!["b".into()]);
     let input = protocol::FrameBuf::with_max_markers(1);
     for (n, since) in [(0, 1), (1, 1), (4, 3)] {
@@ -149,8 +158,13 @@ fn a_refused_start_truncates_nothing() {
     let path = dir.path().join("take.csv");
     std::fs::write(&path, "keep me").expect("write");
     let bad_raw = dir.path().join("missing/raw.csv");
-    assert!(Recording::start(&path, Some(&bad_raw)).is_err());
-    assert!(Recording::start(&path, Some(&dir.path().join("raw.txt"))).is_err());
-    assert!(Recording::start(&path, Some(&dir.path().join("./take.csv"))).is_err());
+    // Even when overwriting is allowed, a start refused for another reason touches nothing.
+    assert!(Recording::start(&path, Some(&bad_raw), true).is_err());
+    assert!(Recording::start(&path, Some(&dir.path().join("raw.txt")), true).is_err());
+    assert!(Recording::start(&path, Some(&dir.path().join("./take.csv")), true).is_err());
+    assert!(matches!(
+        Recording::start(&path, None, false),
+        Err(RecordError::Exists { .. })
+    ));
     assert_eq!(std::fs::read_to_string(&path).expect("read"), "keep me");
 }

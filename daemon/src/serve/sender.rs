@@ -4,9 +4,10 @@
 //! so the daemon's path stays receive → process → send.
 //!
 //! One connected, non-blocking std socket per subscriber: an ICMP port unreachable comes back
-//! as a send error on it, so a vanished client is dropped ([`Clients::handle_send`]). A full
-//! socket send buffer drops that datagram (counted) instead of stalling the thread that
-//! processes every stream.
+//! as a send error on it, so a vanished client is dropped, or a static target backs off
+//! ([`Clients::handle_send`]). A full socket send buffer drops that datagram (counted) instead
+//! of stalling the thread that processes every stream. Each stream's labels go before its
+//! first frame to a subscriber, and once a second.
 
 use std::collections::HashMap;
 use std::io::ErrorKind;
@@ -20,7 +21,7 @@ use protocol::{Control, Profile};
 use super::net::connect;
 use super::stats::{SendCounters, Stats};
 use super::Config;
-use crate::engine::clients::{ClientChange, Clients};
+use crate::engine::clients::{ClientChange, Clients, SendOutcome, Subscriber};
 use crate::engine::pipeline::{Emitted, ProfileMask};
 
 /// How often dynamic subscriptions are checked for expiry.
@@ -48,6 +49,7 @@ impl Fanout {
             &config.send,
             config.max_subscribers,
             config.max_send_failures,
+            config.lease,
         );
         let mut sockets = HashMap::new();
         for &(addr, _) in &config.send {
@@ -74,6 +76,11 @@ impl Fanout {
         self.clients.len()
     }
 
+    /// Every subscriber, for `/status`.
+    pub(crate) fn subscribers(&self) -> impl Iterator<Item = &Subscriber> {
+        self.clients.iter()
+    }
+
     /// Handles `/subscribe` or `/unsubscribe` from `peer`.
     ///
     /// # Errors
@@ -84,7 +91,7 @@ impl Fanout {
             Ok(ClientChange::Added(addr)) => match connect(addr) {
                 Ok(s) => {
                     self.sockets.insert(addr, s);
-                    tracing::info!(%addr, "subscriber added");
+                    tracing::info!(target: "emoshift", %addr, "subscriber added");
                     Ok(())
                 }
                 Err(e) => {
@@ -112,31 +119,55 @@ impl Fanout {
         let gone = self.clients.poll_expired(now);
         for addr in &gone {
             self.sockets.remove(addr);
-            tracing::info!(%addr, "subscription expired");
+            tracing::info!(target: "emoshift", %addr, "subscription expired (not renewed)");
         }
         !gone.is_empty()
     }
 
-    /// Sends one processed frame to every subscriber in its profile; `true` when a subscriber
-    /// was dropped (the wanted profiles may have changed).
+    /// Sends one processed frame to every subscriber of its stream, in its profile, with the
+    /// stream's labels first when they are due; `true` when a subscriber was dropped (the
+    /// wanted profiles may have changed).
     pub(crate) fn send(&mut self, e: &Emitted<'_>, processed: Instant) -> bool {
         let mut dropped_any = false;
+        let stream = (e.identity.id, e.identity.name.as_str());
         let mut i = 0;
         while let Some(s) = self.clients.get(i) {
             let (addr, profile) = (s.addr, s.profile);
+            let plan = self.clients.plan(i, processed, stream, e.labels_due);
+            if !plan.send {
+                i += 1;
+                continue;
+            }
             let ok = match self.sockets.get(&addr) {
-                Some(sock) => send_profile(sock, profile, e, &mut self.counters),
+                Some(sock) => {
+                    let labels_ok = !plan.labels
+                        || e.labels_msg.is_empty()
+                        || send_one(sock, e.labels_msg, &mut self.counters);
+                    labels_ok && send_profile(sock, profile, e, &mut self.counters)
+                }
                 None => false,
             };
             self.counters.send_errors += u64::from(!ok);
-            if self.clients.handle_send(addr, ok) {
-                self.sockets.remove(&addr);
-                self.counters.clients_dropped += 1;
-                dropped_any = true;
-                tracing::warn!(%addr, "subscriber dropped after repeated send failures");
-            } else {
-                i += 1;
+            match self.clients.handle_send(i, ok, processed) {
+                SendOutcome::Dropped => {
+                    self.sockets.remove(&addr);
+                    self.counters.clients_dropped += 1;
+                    dropped_any = true;
+                    tracing::warn!(target: "emoshift", %addr, "subscriber dropped after repeated send failures");
+                    continue;
+                }
+                SendOutcome::BackingOff(wait) => {
+                    self.counters.backoffs += 1;
+                    if wait == crate::engine::clients::FIRST_BACKOFF {
+                        tracing::warn!(target: "emoshift", %addr, "static target not reachable; retrying at most every second");
+                    }
+                }
+                SendOutcome::Recovered => {
+                    tracing::info!(target: "emoshift", %addr, "static target reachable again")
+                }
+                SendOutcome::Sent | SendOutcome::Failed => {}
             }
+            i += 1;
         }
         if !self.clients.is_empty() {
             Stats::record(&mut self.sent_us, processed.elapsed().as_micros() as u64);
@@ -145,15 +176,27 @@ impl Fanout {
     }
 }
 
+/// Sends one datagram; `false` on a send error (a full send buffer is counted as a dropped
+/// datagram, not as the subscriber's failure).
+fn send_one(sock: &UdpSocket, bytes: &[u8], c: &mut SendCounters) -> bool {
+    match sock.send(bytes) {
+        Ok(_) => {
+            c.datagrams_sent += 1;
+            true
+        }
+        Err(err) if err.kind() == ErrorKind::WouldBlock => {
+            c.dropped_send_buffer += 1;
+            true
+        }
+        Err(_) => false,
+    }
+}
+
 /// Sends one frame in `profile`; `false` on a send error (a full send buffer is counted as a
 /// dropped datagram, not as the subscriber's failure).
 fn send_profile(sock: &UdpSocket, profile: Profile, e: &Emitted<'_>, c: &mut SendCounters) -> bool {
     let mut ok = true;
-    let mut one = |bytes: &[u8]| match sock.send(bytes) {
-        Ok(_) => c.datagrams_sent += 1,
-        Err(err) if err.kind() == ErrorKind::WouldBlock => c.dropped_send_buffer += 1,
-        Err(_) => ok = false,
-    };
+    let mut one = |bytes: &[u8]| ok &= send_one(sock, bytes, c);
     match profile {
         Profile::Compact if !e.compact.is_empty() => one(e.compact),
         Profile::Components if !e.components.is_empty() => one(e.components),

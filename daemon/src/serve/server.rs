@@ -23,8 +23,9 @@ use tokio::net::UdpSocket;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
+use super::allow::AllowList;
 use super::command::Request;
-use super::control::{self, ControlCtx};
+use super::control::{self, ControlCtx, Guard};
 use super::processing::{Channels, InFrame, Processing, Shared};
 use super::sender::Fanout;
 use super::stats::Stats;
@@ -39,6 +40,8 @@ const POOL: usize = 256;
 #[derive(Debug)]
 pub struct Bound {
     frames: UdpSocket,
+    /// The frame socket again, for telling a source why its datagram was refused.
+    replies: std::net::UdpSocket,
     control: UdpSocket,
     config: Config,
     model: Arc<IcaModel>,
@@ -51,7 +54,7 @@ pub struct Bound {
 /// # Errors
 /// A socket that cannot be bound or a model that cannot be loaded.
 pub async fn bind(config: Config) -> Result<Bound> {
-    let model = super::load_model(config.model.clone()).await?;
+    let model = super::load_model(config.model.clone(), config.max_model_bytes).await?;
     bind_with(config, model).await
 }
 
@@ -64,18 +67,25 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
     let mut performers = Vec::with_capacity(config.performers.len());
     for p in config.performers.iter().cloned() {
         let model = match &p.model {
-            Some(path) => Some(Arc::new(super::load_model(path.clone()).await?)),
+            Some(path) => Some(Arc::new(
+                super::load_model(path.clone(), config.max_model_bytes).await?,
+            )),
             None => None,
         };
         performers.push(p.with_model(model));
     }
-    let frames = super::net::bind_receiver(config.listen)
+    let frames = super::net::bind_receiver_std(config.listen)
         .with_context(|| format!("binding the frame socket {}", config.listen))?;
+    let replies = frames.try_clone().context("cloning the frame socket")?;
+    replies.set_nonblocking(true)?;
+    frames.set_nonblocking(true)?;
+    let frames = UdpSocket::from_std(frames)?;
     let control = UdpSocket::bind(config.control)
         .await
         .with_context(|| format!("binding the control socket {}", config.control))?;
     Ok(Bound {
         frames,
+        replies,
         control,
         config,
         model,
@@ -107,60 +117,57 @@ impl Bound {
     pub async fn run(self, shutdown: CancellationToken) -> Result<()> {
         let tracker = TaskTracker::new();
         let stats = Arc::new(Mutex::new(Stats::new()));
-        let queue_dropped = Arc::new(AtomicU64::new(0));
+        if let Ok(mut s) = stats.lock() {
+            s.model = self.config.model.display().to_string();
+        }
         let (frame_tx, frame_rx) = crossbeam_channel::bounded::<InFrame>(self.config.queue);
         let (free_tx, free_rx) = crossbeam_channel::bounded::<Vec<u8>>(POOL);
         let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Request>(64);
-
-        let current_model = Arc::new(Mutex::new(Arc::clone(&self.model)));
-        let pipeline = Pipeline::new(
-            self.model,
-            self.performers,
-            PipelineConfig {
-                lowpass_s: self.config.lowpass_s,
-                ..PipelineConfig::default()
-            },
-        );
-        let processing = Processing::new(
-            pipeline,
-            Fanout::new(&self.config)?,
-            self.config.poll_window,
-            Channels {
-                frames: frame_rx.clone(),
-                free: free_tx,
-                commands: cmd_rx,
-            },
-            Shared {
-                stats: Arc::clone(&stats),
-                queue_dropped: Arc::clone(&queue_dropped),
-            },
-        );
-        let processing = tracker.spawn_blocking(move || processing.run());
-
-        let receive = receive(
-            self.frames,
-            frame_tx,
-            frame_rx,
-            free_rx,
-            Arc::clone(&queue_dropped),
-            shutdown.clone(),
-        );
-        tracker.spawn(receive);
+        let shared = Shared {
+            stats: Arc::clone(&stats),
+            queue_dropped: Arc::new(AtomicU64::new(0)),
+            not_allowed: Arc::new(AtomicU64::new(0)),
+            replies: None,
+        };
+        let queue = Queue {
+            tx: frame_tx,
+            rx: frame_rx.clone(),
+            free: free_rx,
+            dropped: Arc::clone(&shared.queue_dropped),
+        };
+        let admission = Admission {
+            allow: self.config.frames_allow.clone(),
+            refused: Arc::clone(&shared.not_allowed),
+        };
+        let channels = Channels {
+            frames: frame_rx,
+            free: free_tx,
+            commands: cmd_rx,
+        };
         let ctx = ControlCtx {
             socket: Arc::new(self.control),
             cmd_tx,
             stats: Arc::clone(&stats),
             model_path: Arc::new(Mutex::new(self.config.model.clone())),
-            model: current_model,
+            model: Arc::new(Mutex::new(Arc::clone(&self.model))),
             tracker: tracker.clone(),
+            guard: Arc::new(Guard::new(&self.config)),
         };
+        let every = self.config.stats_interval;
+        let frames = self.frames;
+        let processing = processing_thread(
+            (self.model, self.performers, self.config),
+            channels,
+            Shared {
+                replies: Some(self.replies),
+                ..shared
+            },
+        )?;
+        let processing = tracker.spawn_blocking(move || processing.run());
+        tracker.spawn(receive(frames, queue, admission, shutdown.clone()));
         tracker.spawn(control::run(ctx.clone(), shutdown.clone()));
         tracker.spawn(control::reload_on_sighup(ctx, shutdown.clone()));
-        tracker.spawn(log_stats(
-            stats,
-            self.config.stats_interval,
-            shutdown.clone(),
-        ));
+        tracker.spawn(log_stats(stats, every, shutdown.clone()));
         tracker.close();
         let result = processing.await;
         tracker.wait().await;
@@ -168,15 +175,61 @@ impl Bound {
     }
 }
 
-/// Receive task: datagrams into the bounded queue, latest frame wins.
+/// The processing thread's state: one engine over the models, the subscribers' sockets.
+fn processing_thread(
+    (model, performers, config): (Arc<IcaModel>, Vec<Performer>, Config),
+    channels: Channels,
+    shared: Shared,
+) -> Result<Processing> {
+    let pipeline = Pipeline::new(
+        model,
+        performers,
+        PipelineConfig {
+            lowpass_s: config.lowpass_s,
+            ..PipelineConfig::default()
+        },
+    );
+    let fanout = Fanout::new(&config)?;
+    Ok(Processing::new(
+        pipeline,
+        fanout,
+        config.poll_window,
+        channels,
+        shared,
+    ))
+}
+
+/// The processing queue's ends as the receive task uses them.
+struct Queue {
+    tx: Sender<InFrame>,
+    /// To drop the oldest frame when full.
+    rx: Receiver<InFrame>,
+    /// Buffers handed back by the processing thread.
+    free: Receiver<Vec<u8>>,
+    /// Frames dropped because the queue was full.
+    dropped: Arc<AtomicU64>,
+}
+
+/// Which sources may send frames.
+struct Admission {
+    allow: AllowList,
+    /// Datagrams from other sources, dropped.
+    refused: Arc<AtomicU64>,
+}
+
+/// Receive task: datagrams from allowed sources into the bounded queue, latest frame wins.
 async fn receive(
     socket: UdpSocket,
-    tx: Sender<InFrame>,
-    rx: Receiver<InFrame>,
-    free: Receiver<Vec<u8>>,
-    dropped: Arc<AtomicU64>,
+    queue: Queue,
+    admission: Admission,
     shutdown: CancellationToken,
 ) {
+    let Queue {
+        tx,
+        rx,
+        free,
+        dropped,
+    } = queue;
     let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
     loop {
         let (len, peer) = tokio::select! {
@@ -185,11 +238,15 @@ async fn receive(
                 Ok(r) => r,
                 // ICMP errors and the like on a UDP socket: nothing to do but go on.
                 Err(e) => {
-                    tracing::trace!(error = %e, "frame socket receive error");
+                    tracing::trace!(target: "emoshift", error = %e, "frame socket receive error");
                     continue;
                 }
             },
         };
+        if !admission.allow.allows(peer.ip()) {
+            admission.refused.fetch_add(1, Ordering::Relaxed);
+            continue;
+        }
         let mut bytes = free.try_recv().unwrap_or_default();
         bytes.clear();
         bytes.extend_from_slice(&buf[..len]);

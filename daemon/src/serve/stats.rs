@@ -1,10 +1,31 @@
 //! Counters and per-stage latency histograms (received → processed → sent), logged every few
 //! seconds and sent as the `/status` reply.
 
+use std::net::SocketAddr;
+
 use hdrhistogram::Histogram;
-use protocol::DecodeErrorKind;
+use protocol::{DecodeErrorKind, Profile, StatusValue};
 
 use crate::engine::{Counters, StreamStatus};
+
+/// One subscriber as `/status` lists it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SubscriberStatus {
+    /// Where it is sent to.
+    pub addr: SocketAddr,
+    /// Its profile.
+    pub profile: Profile,
+    /// The one performer it takes, if any.
+    pub performer: Option<String>,
+    /// Milliseconds left on its lease; `None` for a static target.
+    pub lease_ms: Option<u64>,
+    /// Frames sent to it.
+    pub sends: u64,
+    /// Sends that failed.
+    pub failures: u64,
+    /// Backing off after repeated failures.
+    pub backing_off: bool,
+}
 
 /// Counters of sending.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -15,6 +36,8 @@ pub struct SendCounters {
     pub send_errors: u64,
     /// Subscribers dropped after repeated failures.
     pub clients_dropped: u64,
+    /// Times a static target started backing off after repeated failures.
+    pub backoffs: u64,
     /// Datagrams not sent because the socket's send buffer was full.
     pub dropped_send_buffer: u64,
 }
@@ -40,6 +63,14 @@ pub struct Stats {
     pub poll_misses: u64,
     /// Each stream's counters.
     pub per_stream: Vec<StreamStatus>,
+    /// Each subscriber.
+    pub subscribers: Vec<SubscriberStatus>,
+    /// The default model's file.
+    pub model: String,
+    /// Control messages refused (not allowed, no secret, bad arguments, refused commands).
+    pub control_refused: u64,
+    /// Frames from sources outside `frames_allow`.
+    pub dropped_not_allowed: u64,
 }
 
 impl Default for Stats {
@@ -66,6 +97,10 @@ impl Stats {
             poll_hits: 0,
             poll_misses: 0,
             per_stream: Vec::new(),
+            subscribers: Vec::new(),
+            model: String::new(),
+            control_refused: 0,
+            dropped_not_allowed: 0,
         }
     }
 
@@ -74,11 +109,11 @@ impl Stats {
         h.saturating_record(us.max(1));
     }
 
-    /// `(name, value)` pairs in the order `/status/confirm` carries them.
-    pub fn pairs(&self) -> Vec<(String, i64)> {
+    /// `(name, value)` pairs in the order `/status/confirm` carries them: the counters, each
+    /// stream (`stream/<id>/...`), each subscriber (`subscriber/<n>/...`), the latencies.
+    pub fn pairs(&self) -> Vec<(String, StatusValue)> {
         let c = &self.counters;
-        let i = |v: u64| i64::try_from(v).unwrap_or(i64::MAX);
-        let mut out: Vec<(String, i64)> = [
+        let mut out: Vec<(String, StatusValue)> = [
             ("frames_in", c.frames_in),
             ("frames_out", c.frames_out),
             ("frames_dropped", c.dropped_queue_full),
@@ -86,15 +121,19 @@ impl Stats {
             ("dropped_stale", c.dropped_stale),
             ("dropped_no_layout", c.dropped_no_layout),
             ("dropped_unmatched", c.dropped_unmatched),
+            ("dropped_not_allowed", self.dropped_not_allowed),
             ("frame_errors", c.frame_errors),
             ("labels_in", c.labels_in),
+            ("labels_refused", c.labels_refused),
             ("missing_markers", c.missing_markers),
             ("glitches", c.glitches),
             ("restarts", c.restarts),
             ("model_swaps", c.model_swaps),
             ("bad_packets", c.bad_total()),
+            ("control_refused", self.control_refused),
             ("datagrams_sent", self.send.datagrams_sent),
             ("send_errors", self.send.send_errors),
+            ("send_backoffs", self.send.backoffs),
             ("clients_dropped", self.send.clients_dropped),
             ("dropped_send_buffer", self.send.dropped_send_buffer),
             ("clients", self.clients),
@@ -103,26 +142,23 @@ impl Stats {
             ("poll_misses", self.poll_misses),
         ]
         .into_iter()
-        .map(|(k, v)| (k.to_string(), i(v)))
+        .map(|(k, v)| (k.to_string(), int(v)))
         .collect();
         for kind in DecodeErrorKind::ALL {
-            out.push((format!("bad_{}", kind.as_str()), i(c.bad[kind.index()])));
+            out.push((format!("bad_{}", kind.as_str()), int(c.bad[kind.index()])));
         }
+        out.push(("model".into(), StatusValue::Text(self.model.clone())));
         for st in &self.per_stream {
-            let name = format!("stream/{}/{}", st.key.source, st.key.layout_id);
-            for (what, v) in [
-                ("frames", st.frames),
-                ("dropped_duplicate", st.duplicates),
-                ("dropped_stale", st.stale),
-            ] {
-                out.push((format!("{name}/{what}"), i(v)));
-            }
+            stream_pairs(st, &mut out);
+        }
+        for (n, sub) in self.subscribers.iter().enumerate() {
+            subscriber_pairs(n, sub, &mut out);
         }
         for (name, h) in [("processed", &self.processed_us), ("sent", &self.sent_us)] {
             for (q, label) in [(0.5, "p50"), (0.99, "p99"), (0.999, "p999")] {
-                out.push((format!("{name}_{label}_us"), i(h.value_at_quantile(q))));
+                out.push((format!("{name}_{label}_us"), int(h.value_at_quantile(q))));
             }
-            out.push((format!("{name}_max_us"), i(h.max())));
+            out.push((format!("{name}_max_us"), int(h.max())));
         }
         out
     }
@@ -131,9 +167,17 @@ impl Stats {
     pub fn log(&self) {
         let c = &self.counters;
         tracing::info!(
+            target: "emoshift",
             frames_in = c.frames_in,
             frames_out = c.frames_out,
-            dropped = c.dropped_queue_full + c.dropped_stale + c.dropped_duplicate,
+            dropped = c.dropped_queue_full
+                + c.dropped_stale
+                + c.dropped_duplicate
+                + c.dropped_no_layout
+                + c.dropped_unmatched
+                + self.dropped_not_allowed,
+            labels_refused = c.labels_refused,
+            control_refused = self.control_refused,
             bad_packets = c.bad_total(),
             missing_markers = c.missing_markers,
             clients = self.clients,
@@ -144,9 +188,11 @@ impl Stats {
         );
         for st in &self.per_stream {
             tracing::info!(
+                target: "emoshift",
+                id = st.id,
+                name = %st.name,
                 source = %st.key.source,
                 layout = st.key.layout_id,
-                performer = st.performer.as_deref().unwrap_or("-"),
                 frames = st.frames,
                 dropped_duplicate = st.duplicates,
                 dropped_stale = st.stale,
@@ -154,6 +200,49 @@ impl Stats {
             );
         }
     }
+}
+
+fn int(v: u64) -> StatusValue {
+    StatusValue::Int(i64::try_from(v).unwrap_or(i64::MAX))
+}
+
+fn stream_pairs(st: &StreamStatus, out: &mut Vec<(String, StatusValue)>) {
+    let at = format!("stream/{}", st.id);
+    let text = |s: String| StatusValue::Text(s);
+    out.push((format!("{at}/name"), text(st.name.clone())));
+    out.push((
+        format!("{at}/source"),
+        text(format!("{}/{}", st.key.source, st.key.layout_id)),
+    ));
+    out.push((format!("{at}/emotion"), text(st.target.clone())));
+    out.push((format!("{at}/amount"), text(format!("{:.3}", st.amount))));
+    for (what, v) in [
+        ("model_markers", st.model_markers as u64),
+        ("unmatched_markers", st.unmatched_markers as u64),
+        ("frames", st.frames),
+        ("dropped_duplicate", st.duplicates),
+        ("dropped_stale", st.stale),
+    ] {
+        out.push((format!("{at}/{what}"), int(v)));
+    }
+}
+
+fn subscriber_pairs(n: usize, sub: &SubscriberStatus, out: &mut Vec<(String, StatusValue)>) {
+    let at = format!("subscriber/{n}");
+    let text = |s: &str| StatusValue::Text(s.to_string());
+    out.push((format!("{at}/address"), text(&sub.addr.to_string())));
+    out.push((format!("{at}/profile"), text(sub.profile.as_str())));
+    out.push((
+        format!("{at}/performer"),
+        text(sub.performer.as_deref().unwrap_or("")),
+    ));
+    let lease = sub
+        .lease_ms
+        .map_or(-1, |ms| i64::try_from(ms).unwrap_or(i64::MAX));
+    out.push((format!("{at}/lease_ms"), StatusValue::Int(lease)));
+    out.push((format!("{at}/sends"), int(sub.sends)));
+    out.push((format!("{at}/failures"), int(sub.failures)));
+    out.push((format!("{at}/backing_off"), int(u64::from(sub.backing_off))));
 }
 
 #[cfg(test)]
@@ -171,13 +260,30 @@ mod tests {
                 source: "127.0.0.1:5000".parse().expect("literal address"),
                 layout_id: 2,
             },
-            performer: None,
+            id: 4,
+            name: "alice".into(),
+            performer: Some("alice".into()),
+            model_markers: 12,
+            unmatched_markers: 1,
+            target: "happy".into(),
+            amount: 0.5,
             frames: 7,
             duplicates: 1,
             stale: 3,
         });
         let pairs = s.pairs();
-        let get = |n: &str| pairs.iter().find(|(k, _)| k == n).map(|(_, v)| *v);
+        let get = |n: &str| {
+            pairs
+                .iter()
+                .find(|(k, _)| k == n)
+                .and_then(|(_, v)| v.as_int())
+        };
+        let text = |n: &str| {
+            pairs
+                .iter()
+                .find(|(k, _)| k == n)
+                .and_then(|(_, v)| v.as_text().map(String::from))
+        };
         assert_eq!(get("frames_in"), Some(3));
         assert_eq!(get("bad_packets"), Some(1));
         assert_eq!(
@@ -185,7 +291,10 @@ mod tests {
             Some(1)
         );
         assert_eq!(get("processed_p50_us"), Some(40));
-        assert_eq!(get("stream/127.0.0.1:5000/2/frames"), Some(7));
-        assert_eq!(get("stream/127.0.0.1:5000/2/dropped_stale"), Some(3));
+        assert_eq!(get("stream/4/frames"), Some(7));
+        assert_eq!(get("stream/4/dropped_stale"), Some(3));
+        assert_eq!(text("stream/4/name").as_deref(), Some("alice"));
+        assert_eq!(text("stream/4/source").as_deref(), Some("127.0.0.1:5000/2"));
+        assert_eq!(text("stream/4/emotion").as_deref(), Some("happy"));
     }
 }

@@ -14,11 +14,11 @@ use replay::pacer::{Pacer, PacerOptions};
 
 use super::MARKERS;
 use crate::loopback::source::{drive, Due, Source};
-use crate::loopback::synthetic::frame_into;
 use crate::loopback::{Collecting, ControlClient, Daemon, Received, Receiver};
 use crate::serve::config::RawConfig;
 use crate::serve::net::bind_receiver_std;
 use crate::serve::stats::Stats;
+use crate::synthetic::frame_into;
 
 /// What the receivers saw.
 pub(super) struct Seen {
@@ -30,7 +30,7 @@ pub(super) struct Seen {
 pub(super) struct Run {
     pub(super) seen: Seen,
     pub(super) sent: u64,
-    pub(super) status: Vec<(String, i64)>,
+    pub(super) status: Vec<(String, protocol::StatusValue)>,
 }
 
 impl Seen {
@@ -57,10 +57,7 @@ impl Run {
     }
 
     pub(super) fn get(&self, name: &str) -> i64 {
-        self.status
-            .iter()
-            .find(|(k, _)| k == name)
-            .map_or(-1, |(_, v)| *v)
+        crate::loopback::counter(&self.status, name).unwrap_or(-1)
     }
 }
 

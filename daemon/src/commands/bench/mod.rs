@@ -22,7 +22,7 @@ use protocol::{encode_frame_into, FrameBuf};
 
 use crate::cli::BenchArgs;
 use crate::engine::pipeline::{Pipeline, PipelineConfig};
-use crate::loopback::synthetic::{frame_into, labels_datagram, random_model};
+use crate::synthetic::{frame_into, labels_datagram, random_model};
 use harness::{through_daemon, through_relay, Run};
 
 const MARKERS: usize = 109;

@@ -43,12 +43,12 @@ fn step(n: usize, text: &str) -> Result<()> {
 pub(crate) fn run(args: &DemoArgs) -> Result<()> {
     let started = Instant::now();
     let (dir, temporary) = match &args.keep {
-        Some(d) => (d.clone(), false),
-        None => (std::env::temp_dir().join("emoshift-demo"), true),
+        Some(d) => {
+            crate::offline::output::check_out_dir(d, false)?;
+            (d.clone(), false)
+        }
+        None => (fresh_temp_dir()?, true),
     };
-    if temporary && dir.exists() {
-        std::fs::remove_dir_all(&dir).with_context(|| format!("cannot clear {}", dir.display()))?;
-    }
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let result = chain(args, &dir, started);
     if temporary {
@@ -70,6 +70,20 @@ pub(crate) fn run(args: &DemoArgs) -> Result<()> {
         }
     }
     result
+}
+
+/// A new folder under the system's temporary folder, never one that was there before.
+fn fresh_temp_dir() -> Result<PathBuf> {
+    let base = std::env::temp_dir();
+    for k in 0..100 {
+        let dir = base.join(format!("emoshift-demo-{}-{k}", std::process::id()));
+        match std::fs::create_dir(&dir) {
+            Ok(()) => return Ok(dir),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e).with_context(|| format!("cannot create {}", dir.display())),
+        }
+    }
+    anyhow::bail!("no free folder name under {}", base.display())
 }
 
 /// The inputs of training and analysis, and the take to stream.
@@ -99,9 +113,7 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
     let model_path = dir.join("model.json");
     let takes = crate::offline::load_inputs(Some(&session.manifest), &[])?;
     let options = match &session.regions {
-        Some(path) => options_with_regions(
-            Regions::load(path).with_context(|| format!("{}", path.display()))?,
-        ),
+        Some(path) => options_with_regions(Regions::load(path)?),
         None => TrainOptions::default(),
     };
     train_and_save(&takes, &options, &model_path)?;

@@ -1,7 +1,8 @@
 //! Encoding a processed frame once per profile the subscribers want.
 
 use protocol::{
-    encode_compact_into, encode_components_into, FlatSplit, FrameBuf, Profile, ETHERNET_PAYLOAD,
+    encode_compact_into, encode_components_into, FlatSplit, FrameBuf, Profile, StreamTag,
+    ETHERNET_PAYLOAD,
 };
 
 use crate::engine::edit_state::EditState;
@@ -52,6 +53,7 @@ impl Outputs {
     pub(super) fn encode(
         &mut self,
         wanted: ProfileMask,
+        tag: &StreamTag<'_>,
         frame: &FrameBuf,
         edit: &EditState,
         u: &[f32],
@@ -62,14 +64,14 @@ impl Outputs {
         self.parts.clear();
         self.part_ends.clear();
         if wanted & profile_bit(Profile::Compact) != 0 {
-            encode_compact_into(frame, edit.target(), edit.amount(), &mut self.compact)?;
+            encode_compact_into(tag, frame, edit.target(), edit.amount(), &mut self.compact)?;
         }
         if wanted & profile_bit(Profile::Components) != 0 {
-            encode_components_into(u, vmc, &mut self.components)?;
+            encode_components_into(tag, u, vmc, &mut self.components)?;
         }
         if wanted & profile_bit(Profile::FlatSplit) != 0 {
             for i in 0..self.split.part_count(frame.marker_count()) {
-                self.split.encode_part_into(frame, i, &mut self.part);
+                self.split.encode_part_into(tag, frame, i, &mut self.part)?;
                 self.parts.extend_from_slice(&self.part);
                 self.part_ends.push(self.parts.len());
             }

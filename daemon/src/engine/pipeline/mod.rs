@@ -10,11 +10,12 @@ use std::sync::Arc;
 
 use ica_core::model::IcaModel;
 use protocol::{
-    decode_frame_into, decode_labels, messages, Address, Control, FrameBuf, LayoutBook,
-    LayoutChange, Limits, Profile,
+    decode_frame_into, decode_labels, messages, Address, Control, DecodeError, FrameBuf,
+    LayoutBook, LayoutChange, Limits, Profile,
 };
 
 use crate::engine::edit_state::{EditRefused, EditState};
+use crate::engine::stream::Identity;
 use crate::engine::streams::{Performer, StreamKey, StreamStatus, Streams};
 use crate::engine::Counters;
 
@@ -26,6 +27,48 @@ pub use encode::{profile_bit, ProfileMask};
 pub use setup::apply_edit;
 use setup::new_stream;
 
+/// A source's datagram refused with a reason it should hear (`/emoshift/error` on the frame
+/// socket); the shell sends it, rate-limited.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Refusal {
+    /// The source.
+    pub to: SocketAddr,
+    /// Why.
+    pub why: String,
+}
+
+/// A model refused because running streams lack some of its markers.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}", describe_mismatch(streams))]
+pub struct ModelMismatch {
+    /// Each stream it does not fit, with the model's markers the stream's source does not name.
+    pub streams: Vec<(String, Vec<String>)>,
+}
+
+fn describe_mismatch(streams: &[(String, Vec<String>)]) -> String {
+    let each: Vec<String> = streams
+        .iter()
+        .map(|(name, missing)| {
+            let shown: Vec<&str> = missing.iter().take(8).map(String::as_str).collect();
+            let more = missing.len().saturating_sub(shown.len());
+            let more = if more > 0 {
+                format!(" and {more} more")
+            } else {
+                String::new()
+            };
+            format!(
+                "stream {name} lacks {} of its markers: {}{more}",
+                missing.len(),
+                shown.join(", ")
+            )
+        })
+        .collect();
+    format!(
+        "the model does not fit the running streams, kept the old one: {}",
+        each.join("; ")
+    )
+}
+
 /// Sources tracked for labels, and streams, at most (bounds memory against spoofed senders).
 pub const MAX_SOURCES: usize = 64;
 
@@ -34,6 +77,13 @@ pub const MAX_SOURCES: usize = 64;
 pub struct Emitted<'a> {
     /// The stream.
     pub key: StreamKey,
+    /// Who the stream is to subscribers.
+    pub identity: &'a Identity,
+    /// The stream's `/mocap/labels` (model order, layout id = stream id).
+    pub labels_msg: &'a [u8],
+    /// The labels go to every subscriber with this frame (the stream's first, then once a
+    /// second); a subscriber new to the stream gets them with its first frame regardless.
+    pub labels_due: bool,
     /// Frame number.
     pub frame_number: i32,
     /// Frame numbers since the stream's previous processed frame: 1 when none was lost or
@@ -92,6 +142,8 @@ pub struct Pipeline {
     frame_out: FrameBuf,
     outputs: Outputs,
     wanted: ProfileMask,
+    /// The last refusal the source should hear, taken by the shell after each datagram.
+    refusal: Option<Refusal>,
     /// Counters, read by the caller after each batch.
     pub counters: Counters,
 }
@@ -108,12 +160,18 @@ impl Pipeline {
             frame_out: FrameBuf::with_max_markers(config.max_markers),
             outputs: Outputs::new(config.max_markers),
             wanted: profile_bit(Profile::Compact),
+            refusal: None,
             counters: Counters::default(),
             template,
             model,
             performers,
             config,
         }
+    }
+
+    /// The refusal of the last datagram, if it was refused with a reason for its source.
+    pub fn take_refusal(&mut self) -> Option<Refusal> {
+        self.refusal.take()
     }
 
     /// Sets which profiles are encoded (the subscribers' profiles).
@@ -131,8 +189,32 @@ impl Pipeline {
         self.streams.status(&self.performers)
     }
 
+    /// Whether `model` can replace the default model: every stream running on the default
+    /// model must name all of `model`'s markers, or it would be left with markers it never
+    /// sees (or none at all).
+    ///
+    /// # Errors
+    /// The streams it does not fit and the markers each lacks.
+    pub fn check_model(&self, model: &IcaModel) -> Result<(), ModelMismatch> {
+        let mut streams = Vec::new();
+        for (_, stream) in self.streams.iter() {
+            if !Arc::ptr_eq(&stream.model, &self.model) {
+                continue;
+            }
+            let missing = stream.missing_from_source(model.labels());
+            if !missing.is_empty() {
+                streams.push((stream.identity.name.clone(), missing));
+            }
+        }
+        match streams.is_empty() {
+            true => Ok(()),
+            false => Err(ModelMismatch { streams }),
+        }
+    }
+
     /// Swaps in a new default model at a frame boundary: streams on the default model are
-    /// rebuilt on it, keeping their edit settings; no frame is dropped.
+    /// rebuilt on it, keeping their edit settings; no frame is dropped. Check it with
+    /// [`Pipeline::check_model`] first: a stream it does not fit keeps the old model.
     pub fn set_model(&mut self, model: Arc<IcaModel>) {
         let mut template = EditState::for_model(&model, self.config.lowpass_s);
         template.copy_settings(&self.template);
@@ -201,6 +283,13 @@ impl Pipeline {
                     self.streams.forget(peer, id);
                 }
             }
+            Err(e @ DecodeError::DuplicateLabel { index }) => {
+                // A layout whose names repeat maps no frame; the last good one stays.
+                self.counters.bad_packet(e.kind());
+                self.counters.labels_refused += 1;
+                let why = format!("the marker name at argument {index} is named twice");
+                self.refusal = Some(Refusal { to: peer, why });
+            }
             Err(e) => self.counters.bad_packet(e.kind()),
         }
     }
@@ -225,8 +314,9 @@ impl Pipeline {
         };
         let (performers, template) = (&self.performers, &self.template);
         let (default_model, lowpass_s) = (&self.model, self.config.lowpass_s);
-        let Some(stream) = self.streams.get_or_create(key, || {
+        let Some(stream) = self.streams.get_or_create(key, |id| {
             new_stream(
+                id,
                 &key,
                 &labels.names,
                 performers,
@@ -238,24 +328,27 @@ impl Pipeline {
             return self.counters.dropped_unmatched += 1;
         };
         let counters = &mut self.counters;
-        let Some(frames) = stream.process(&header, &self.frame_in, &mut self.frame_out, counters)
+        let Some(done) = stream.process(&header, &self.frame_in, &mut self.frame_out, counters)
         else {
             return;
         };
-        let (edit, u, vmc) = (&stream.edit, stream.components(), &stream.vmc);
-        if (self
+        let (tag, edit) = (stream.identity.tag(), &stream.edit);
+        let (u, vmc) = (stream.components(), &stream.vmc);
+        let encoded = self
             .outputs
-            .encode(self.wanted, &self.frame_out, edit, u, vmc))
-        .is_err()
-        {
+            .encode(self.wanted, &tag, &self.frame_out, edit, u, vmc);
+        if encoded.is_err() {
             return self.counters.frame_errors += 1;
         }
         self.counters.frames_out += 1;
         let out = &self.outputs;
         emit(&Emitted {
             key,
+            identity: &stream.identity,
+            labels_msg: stream.labels_msg(),
+            labels_due: done.labels_due,
             frame_number: header.frame_number,
-            frames_since_last: frames,
+            frames_since_last: done.frames_since_last,
             compact: &out.compact,
             parts: &out.parts,
             part_ends: &out.part_ends,

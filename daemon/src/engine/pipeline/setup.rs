@@ -6,12 +6,14 @@ use ica_core::model::IcaModel;
 use protocol::Control;
 
 use crate::engine::edit_state::EditRefused;
-use crate::engine::stream::Stream;
+use crate::engine::stream::{Identity, Stream};
 use crate::engine::streams::{Performer, StreamKey};
 
-/// A new stream for `key` on its performer's model (or the default one, with the template's
-/// edit settings); `None` when its labels share none with the model.
+/// A new stream `id` for `key` on its performer's model (or the default one, with the
+/// template's edit settings), named after its performer or its source; `None` when its labels
+/// share none with the model.
 pub(super) fn new_stream(
+    id: i32,
     key: &StreamKey,
     source_labels: &[String],
     performers: &[Performer],
@@ -24,7 +26,18 @@ pub(super) fn new_stream(
     let model = p
         .and_then(|p| p.model.clone())
         .unwrap_or_else(|| Arc::clone(default_model));
-    let mut stream = Stream::new(Arc::clone(&model), performer, source_labels, lowpass_s).ok()?;
+    let identity = match p {
+        Some(p) => Identity::new(id, &p.name),
+        None => Identity::new(id, &format!("{}/{}", key.source, key.layout_id)),
+    };
+    let mut stream = Stream::new(
+        identity,
+        Arc::clone(&model),
+        performer,
+        source_labels,
+        lowpass_s,
+    )
+    .ok()?;
     if Arc::ptr_eq(&model, default_model) {
         stream.edit.copy_settings(template);
     }

@@ -8,7 +8,7 @@ use protocol::{
 
 use super::*;
 use crate::engine::frame::FrameProcessor;
-use crate::loopback::synthetic::{frame_into, random_model};
+use crate::synthetic::{frame_into, random_model};
 
 const MARKERS: usize = 12;
 
@@ -48,8 +48,8 @@ fn run(p: &mut Pipeline, datagrams: &[Vec<u8>]) -> Vec<(i32, Vec<f32>)> {
         p.handle_datagram(peer(), d, &mut |e| {
             let msg = messages(e.compact, &protocol::Limits::default())
                 .expect("well-formed")
-                .next()
-                .expect("the frame comes first");
+                .find(|m| m.address == protocol::address::FRAME)
+                .expect("the bundle holds the frame");
             let mut buf = FrameBuf::new();
             decode_frame_into(msg.bytes, &mut buf).expect("valid frame");
             got.push((e.frame_number, buf.positions().to_vec()));

@@ -170,7 +170,7 @@ pub fn project_session(model: &IcaModel, session: &Session) -> Result<Vec<Sessio
 /// # Errors
 /// Unreadable file, a region naming no marker, or a missing mouth/eyebrows/eyelids region.
 pub fn resolve_regions(path: &Path, model: &IcaModel) -> Result<BTreeMap<String, Vec<usize>>> {
-    let regions = Regions::load(path).with_context(|| format!("{}", path.display()))?;
+    let regions = Regions::load(path)?;
     let resolved = regions
         .resolve(model.labels())
         .with_context(|| format!("{}", path.display()))?;

@@ -1,0 +1,88 @@
+//! Where a command may write: never over one of its own inputs, and over an existing file or
+//! folder only when the user said `--force`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+
+use crate::exit::UsageError;
+
+/// The path with its folder resolved (the file itself need not exist).
+fn resolved(p: &Path) -> PathBuf {
+    if let Ok(c) = p.canonicalize() {
+        return c;
+    }
+    let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+    match (
+        dir.map_or(std::env::current_dir(), Path::canonicalize),
+        p.file_name(),
+    ) {
+        (Ok(d), Some(name)) => d.join(name),
+        _ => p.to_path_buf(),
+    }
+}
+
+/// Checks that `out` is none of `inputs`, and that it does not exist unless `force`.
+///
+/// # Errors
+/// A [`UsageError`] naming the path and what to do.
+pub fn check_out(out: &Path, inputs: &[&Path], force: bool) -> Result<()> {
+    let target = resolved(out);
+    if let Some(input) = inputs.iter().find(|i| resolved(i) == target) {
+        return Err(UsageError(format!(
+            "{} is also an input ({}); write the output elsewhere",
+            out.display(),
+            input.display()
+        ))
+        .into());
+    }
+    let exists = std::fs::symlink_metadata(out).is_ok();
+    if exists && !force {
+        return Err(UsageError(format!(
+            "{} exists; pass --force to overwrite it",
+            out.display()
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// Checks that the folder `out` is empty or absent unless `force` (its files would be
+/// replaced).
+///
+/// # Errors
+/// A [`UsageError`] naming the folder.
+pub fn check_out_dir(out: &Path, force: bool) -> Result<()> {
+    let busy = std::fs::read_dir(out).is_ok_and(|mut entries| entries.next().is_some());
+    if busy && !force {
+        return Err(UsageError(format!(
+            "{} exists and is not empty; pass --force to write into it",
+            out.display()
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_input_is_never_the_output_and_existing_files_need_force() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let take = dir.path().join("take.trc");
+        std::fs::write(&take, "x").expect("writable");
+        let e = check_out(&take, &[&take], true).expect_err("its own input");
+        assert!(e.to_string().contains("also an input"), "{e}");
+        let same = dir.path().join(".").join("take.trc");
+        assert!(
+            check_out(&same, &[&take], true).is_err(),
+            "the same file by another path"
+        );
+        let e = check_out(&take, &[], false).expect_err("exists");
+        assert!(e.to_string().contains("--force"), "{e}");
+        assert!(check_out(&take, &[], true).is_ok());
+        assert!(check_out(&dir.path().join("new.trc"), &[&take], false).is_ok());
+    }
+}
