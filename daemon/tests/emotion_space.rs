@@ -81,6 +81,7 @@ fn transfer_sums(dir: &Path, original: &Take, target: &str, truth: &Take) -> (f6
             target,
             "--amount",
             amount,
+            "--force",
         ]);
         replay::load(out).expect("edited")
     };
@@ -154,7 +155,15 @@ fn replace_error(dir: &Path, synth: &Synth, sentence: usize, from: &str, to: &st
     let model = dir.join("model.json");
     let zero = dir.join("zero.c3d");
     let moved = dir.join("replaced.c3d");
-    emoshift(&["edit", "--model", s(&model), s(&input), "--out", s(&zero)]);
+    emoshift(&[
+        "edit",
+        "--model",
+        s(&model),
+        s(&input),
+        "--out",
+        s(&zero),
+        "--force",
+    ]);
     emoshift(&[
         "edit",
         "--model",
@@ -164,6 +173,7 @@ fn replace_error(dir: &Path, synth: &Synth, sentence: usize, from: &str, to: &st
         s(&moved),
         "--replace-emotion-from",
         s(&other_path),
+        "--force",
     ]);
     let (zero, moved) = (
         replay::load(&zero).expect("zero"),

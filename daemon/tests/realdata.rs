@@ -140,6 +140,7 @@ fn amount_zero_reproduces(takes: &[PathBuf], regions: &str, head: &[&str]) {
             s(take),
             "--out",
             s(&edited),
+            "--force",
         ]);
         let input = offline::load_take(take).expect("input");
         let output = offline::load_take(&edited).expect("output");

@@ -129,7 +129,7 @@ fn inject(take: &mut replay::Take, head: &[usize], amplitude_mm: f64, seed: u64)
 /// concatenated `signals`.
 fn best_recovery(dir: &Path, takes: &[PathBuf], signals: &[Vec<f64>]) -> f64 {
     let model = dir.join("model.json");
-    let mut args = vec!["train", "--out", s(&model)];
+    let mut args = vec!["train", "--force", "--out", s(&model)];
     args.extend(takes.iter().map(|p| s(p)));
     let out = emoshift(&args);
     for line in out
@@ -462,7 +462,7 @@ fn issue12_other_layouts_get_the_right_head_decision_and_their_sources_back() {
             );
             // The sources come back as components, with default settings.
             let model = dir.path().join("model.json");
-            let mut args = vec!["train", "--out", s(&model)];
+            let mut args = vec!["train", "--force", "--out", s(&model)];
             args.extend(paths.iter().map(|p| s(p)));
             emoshift(&args);
             let series = project_series(&model, &paths);

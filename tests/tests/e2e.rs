@@ -7,4 +7,5 @@ mod e2e {
     mod edit;
     mod faults;
     mod shutdown;
+    mod stage;
 }

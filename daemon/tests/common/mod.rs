@@ -47,7 +47,15 @@ pub fn project_series(model: &Path, takes: &[std::path::PathBuf]) -> Vec<Vec<f64
     let mut series: Vec<Vec<f64>> = Vec::new();
     for take in takes {
         let csv = take.with_extension("components.csv");
-        ok(&["project", "--model", p(model), p(take), "--out", p(&csv)]);
+        ok(&[
+            "project",
+            "--model",
+            p(model),
+            p(take),
+            "--out",
+            p(&csv),
+            "--force",
+        ]);
         let text = std::fs::read_to_string(&csv).expect("components csv");
         for line in text.lines().skip(1) {
             let values: Vec<f64> = line

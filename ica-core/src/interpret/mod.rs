@@ -46,7 +46,7 @@ pub enum InterpretError {
     #[error("region has no markers")]
     EmptyRegion,
     /// Alignment failed.
-    #[error("dtw: {0}")]
+    #[error("dtw")]
     Dtw(#[from] DtwError),
 }
 

@@ -7,13 +7,13 @@
 #[non_exhaustive]
 pub enum ModelError {
     /// Reading the model bytes failed.
-    #[error("cannot read model: {0}")]
+    #[error("cannot read model")]
     Read(#[source] std::io::Error),
     /// Writing the model failed.
-    #[error("cannot write model: {0}")]
+    #[error("cannot write model")]
     Write(#[source] serde_json::Error),
     /// The bytes are not a model file of the supported layout.
-    #[error("malformed model file at line {line}, column {column}: {source}")]
+    #[error("malformed model file at line {line}, column {column}")]
     Malformed {
         /// 1-based line of the error.
         line: usize,

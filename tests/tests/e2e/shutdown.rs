@@ -34,6 +34,7 @@ async fn a_recording_is_complete_after_sigterm() {
     let start = Control::RecordStart {
         path: out.display().to_string(),
         raw: Some(raw_out.display().to_string()),
+        overwrite: false,
     };
     // The child needs a moment to bind: retry the first control until it answers.
     let mut reply = None;
@@ -132,4 +133,81 @@ fn stage_frames(model: &ica_core::model::IcaModel, n: usize) -> Sent {
         datagrams,
         take,
     }
+}
+
+/// The child's peak resident memory, kB.
+fn peak_rss_kb(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).expect("proc status");
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .expect("VmHWM")
+}
+
+#[tokio::test]
+async fn model_load_of_a_device_or_a_fifo_is_answered_at_once_and_sigterm_still_exits() {
+    let m = model_file(32);
+    let fifo = m.dir.path().join("model.fifo");
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let (fp, cp) = (free_port(), free_port());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"))
+        .args(["serve", "--model"])
+        .arg(&m.path)
+        .args(["--listen", &format!("127.0.0.1:{fp}")])
+        .args(["--control", &format!("127.0.0.1:{cp}")])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("the binary starts");
+    let control = ControlClient::new(format!("127.0.0.1:{cp}").parse().expect("addr")).await;
+    let mut up = false;
+    for _ in 0..50 {
+        let attempt =
+            tokio::time::timeout(Duration::from_millis(200), control.send(&Control::Status));
+        if attempt.await.is_ok() {
+            up = true;
+            break;
+        }
+    }
+    assert!(up, "the daemon answers /status");
+    for path in ["/dev/zero".into(), fifo.display().to_string()] {
+        let t = Instant::now();
+        let reply = tokio::time::timeout(
+            Duration::from_secs(1),
+            control.send(&Control::ModelLoad(path.clone())),
+        )
+        .await
+        .unwrap_or_else(|_| panic!("/model/load {path} answered within 1 s"));
+        match reply {
+            Reply::Error { message, .. } => {
+                assert!(message.contains("not a regular file"), "{path}: {message}")
+            }
+            other => panic!("/model/load {path}: {other:?}"),
+        }
+        assert!(t.elapsed() < Duration::from_secs(1));
+    }
+    let peak = peak_rss_kb(child.id());
+    assert!(peak < 200_000, "peak RSS {peak} kB");
+    let t = Instant::now();
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(status.success());
+    let exit = loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            break s;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(1),
+            "still running 1 s after SIGTERM"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    assert!(exit.success(), "exit status {exit:?}");
 }
