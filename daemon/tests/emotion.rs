@@ -7,7 +7,7 @@ use std::path::Path;
 use replay::synth::{load_truth, Synth, SynthParams};
 
 mod common;
-use common::{corr, ok as emoshift};
+use common::{corr, ok as emoshift, project_series};
 
 fn params(seed: u64, sentences: usize) -> SynthParams {
     SynthParams {
@@ -54,34 +54,8 @@ fn session(dir: &Path, seed: u64, sentences: usize) {
 
 /// Component series of every take (concatenated) from `emoshift project`.
 fn components(dir: &Path, takes: &[String]) -> Vec<Vec<f64>> {
-    let d = dir.to_str().expect("utf-8");
-    let mut series: Vec<Vec<f64>> = Vec::new();
-    for name in takes {
-        let csv = format!("{d}/{name}.csv");
-        emoshift(&[
-            "project",
-            "--model",
-            &format!("{d}/model.json"),
-            &format!("{d}/{name}.c3d"),
-            "--out",
-            &csv,
-        ]);
-        let text = std::fs::read_to_string(&csv).expect("components csv");
-        for line in text.lines().skip(1) {
-            let values: Vec<f64> = line
-                .split(',')
-                .skip(2)
-                .map(|v| v.parse().expect("number"))
-                .collect();
-            if series.is_empty() {
-                series = vec![Vec::new(); values.len()];
-            }
-            for (s, v) in series.iter_mut().zip(values) {
-                s.push(v);
-            }
-        }
-    }
-    series
+    let paths: Vec<_> = takes.iter().map(|n| dir.join(format!("{n}.c3d"))).collect();
+    project_series(&dir.join("model.json"), &paths)
 }
 
 /// Sentences per session: 12 sentences x 3 emotions is about 12,800 frames, the size of the
