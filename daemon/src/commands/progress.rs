@@ -1,0 +1,246 @@
+//! Drawing [`Progress`]: a bar on a terminal (indicatif), and in a pipe or a log a line on
+//! stderr when a step starts, every [`LINE_INTERVAL`] while it runs (done, total, rate, ETA)
+//! and when it ends, so a job run under `nohup` or CI shows where it is.
+
+use std::io::{IsTerminal, Write};
+use std::time::{Duration, Instant};
+
+use indicatif::{HumanCount, ProgressBar, ProgressStyle};
+
+use crate::offline::progress::Progress;
+
+/// Time between two progress lines when stderr is not a terminal.
+pub const LINE_INTERVAL: Duration = Duration::from_secs(5);
+
+/// The progress display of a command: a bar on a terminal, lines otherwise.
+pub fn for_stderr(command: &'static str) -> Box<dyn Progress> {
+    if std::io::stderr().is_terminal() {
+        Box::new(Bar::new(command))
+    } else {
+        Box::new(Lines::new(command, std::io::stderr(), LINE_INTERVAL))
+    }
+}
+
+/// An indicatif bar per step (a spinner when the total is unknown).
+#[derive(Debug)]
+struct Bar {
+    command: &'static str,
+    bar: Option<ProgressBar>,
+}
+
+impl Bar {
+    fn new(command: &'static str) -> Self {
+        Self { command, bar: None }
+    }
+}
+
+impl Progress for Bar {
+    fn step(&mut self, name: &str, unit: &'static str, total: Option<u64>) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+        let template = match total {
+            Some(_) => format!(
+                "{{prefix}} {{wide_bar}} {{human_pos}}/{{human_len}} {unit} {{per_sec}} ETA {{eta}} {{msg}}"
+            ),
+            None => format!("{{prefix}} {{spinner}} {{human_pos}} {unit} {{per_sec}} {{msg}}"),
+        };
+        let style = ProgressStyle::with_template(&template)
+            .expect("the templates above are valid")
+            .progress_chars("=> ");
+        let bar = match total {
+            Some(n) => ProgressBar::new(n),
+            None => ProgressBar::new_spinner(),
+        };
+        bar.set_style(style);
+        bar.set_prefix(format!("{}: {name}", self.command));
+        bar.enable_steady_tick(Duration::from_millis(200));
+        self.bar = Some(bar);
+    }
+
+    fn advance(&mut self, n: u64) {
+        if let Some(bar) = &self.bar {
+            bar.inc(n);
+        }
+    }
+
+    fn note(&mut self, text: &str) {
+        if let Some(bar) = &self.bar {
+            bar.set_message(text.to_string());
+        }
+    }
+
+    fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// Plain lines: a step's start, its state every `interval`, its end.
+#[derive(Debug)]
+pub struct Lines<W: Write> {
+    command: &'static str,
+    out: W,
+    interval: Duration,
+    step: Option<Step>,
+    note: String,
+}
+
+#[derive(Debug)]
+struct Step {
+    name: String,
+    unit: &'static str,
+    total: Option<u64>,
+    done: u64,
+    started: Instant,
+    last_line: Instant,
+}
+
+impl<W: Write> Lines<W> {
+    /// Lines for `command` into `out`, one every `interval` while a step runs.
+    pub fn new(command: &'static str, out: W, interval: Duration) -> Self {
+        Self {
+            command,
+            out,
+            interval,
+            step: None,
+            note: String::new(),
+        }
+    }
+
+    /// The writer (tests read what was written).
+    pub fn into_inner(self) -> W {
+        self.out
+    }
+
+    fn end_step(&mut self) {
+        let Some(s) = self.step.take() else {
+            return;
+        };
+        let secs = s.started.elapsed().as_secs_f64();
+        let rate = s.done as f64 / secs.max(1e-9);
+        // Progress lines are best effort: a closed stderr must not fail the work.
+        let _ = writeln!(
+            self.out,
+            "{}: {} done: {} {} in {secs:.1} s ({} {}/s){}",
+            self.command,
+            s.name,
+            HumanCount(s.done),
+            s.unit,
+            HumanCount(rate as u64),
+            s.unit,
+            note(&self.note)
+        );
+    }
+
+    fn line(&mut self) {
+        let Some(s) = &self.step else {
+            return;
+        };
+        let secs = s.started.elapsed().as_secs_f64();
+        let rate = s.done as f64 / secs.max(1e-9);
+        let of = match s.total {
+            Some(t) => {
+                let eta = if rate > 0.0 {
+                    format!(", ETA {:.0} s", t.saturating_sub(s.done) as f64 / rate)
+                } else {
+                    String::new()
+                };
+                format!(
+                    " / {} {} ({:.0} %){eta}",
+                    HumanCount(t),
+                    s.unit,
+                    100.0 * s.done as f64 / t.max(1) as f64
+                )
+            }
+            None => format!(" {}", s.unit),
+        };
+        let _ = writeln!(
+            self.out,
+            "{}: {}: {}{of}, {} {}/s{}",
+            self.command,
+            s.name,
+            HumanCount(s.done),
+            HumanCount(rate as u64),
+            s.unit,
+            note(&self.note)
+        );
+    }
+}
+
+fn note(text: &str) -> String {
+    if text.is_empty() {
+        String::new()
+    } else {
+        format!(" [{text}]")
+    }
+}
+
+impl<W: Write> Progress for Lines<W> {
+    fn step(&mut self, name: &str, unit: &'static str, total: Option<u64>) {
+        self.end_step();
+        self.note.clear();
+        let of = total.map_or(String::new(), |t| format!(" ({} {unit})", HumanCount(t)));
+        let _ = writeln!(self.out, "{}: {name}{of}", self.command);
+        let now = Instant::now();
+        self.step = Some(Step {
+            name: name.to_string(),
+            unit,
+            total,
+            done: 0,
+            started: now,
+            last_line: now,
+        });
+    }
+
+    fn advance(&mut self, n: u64) {
+        let Some(s) = &mut self.step else {
+            return;
+        };
+        s.done += n;
+        if s.last_line.elapsed() >= self.interval {
+            s.last_line = Instant::now();
+            self.line();
+        }
+    }
+
+    fn note(&mut self, text: &str) {
+        self.note.clear();
+        self.note.push_str(text);
+    }
+
+    fn finish(&mut self) {
+        self.end_step();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_give_totals_rate_and_eta() {
+        let mut lines = Lines::new("train", Vec::new(), Duration::ZERO);
+        lines.step("statistics", "frames", Some(1_000));
+        lines.advance(250);
+        lines.note("12 gappy frames");
+        lines.step("refinement", "iterations", None);
+        lines.advance(3);
+        lines.finish();
+        let text = String::from_utf8(lines.into_inner()).expect("utf-8");
+        let rows: Vec<&str> = text.lines().collect();
+        assert_eq!(rows[0], "train: statistics (1,000 frames)");
+        assert!(
+            rows[1].starts_with("train: statistics: 250 / 1,000 frames (25 %), ETA "),
+            "{text}"
+        );
+        assert!(rows[1].contains("frames/s"), "{text}");
+        assert!(rows[2].starts_with("train: statistics done: 250 frames in "), "{text}");
+        assert!(rows[2].ends_with("[12 gappy frames]"), "{text}");
+        assert_eq!(rows[3], "train: refinement");
+        assert!(rows[4].starts_with("train: refinement: 3 iterations, "), "{text}");
+        assert!(rows[5].starts_with("train: refinement done: 3 iterations"), "{text}");
+        assert_eq!(rows.len(), 6);
+    }
+}
