@@ -1,6 +1,7 @@
 //! Offline glue between takes and models: loading the inputs of a command, putting takes in a
 //! model's marker order, projecting and resynthesising whole takes.
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -134,16 +135,21 @@ impl ModelFrames {
 
 /// Gathers a whole take into model order.
 pub fn to_model_order(take: &Take, map: &LabelMap) -> ModelFrames {
+    frames_in_model_order(take, map, 0..take.n_frames())
+}
+
+/// Gathers frames `range` of a take into model order.
+pub fn frames_in_model_order(take: &Take, map: &LabelMap, range: Range<usize>) -> ModelFrames {
     let markers = map.model_to_take.len();
-    let frames = take.n_frames();
+    let frames = range.len();
     let mut xyz = vec![0.0; frames * markers * 3];
     let mut missing = vec![true; frames * markers];
-    for f in 0..frames {
+    for (k, f) in range.enumerate() {
         map.gather_into(
             take.frame(f),
             take.frame_missing(f),
-            &mut xyz[f * markers * 3..(f + 1) * markers * 3],
-            &mut missing[f * markers..(f + 1) * markers],
+            &mut xyz[k * markers * 3..(k + 1) * markers * 3],
+            &mut missing[k * markers..(k + 1) * markers],
         );
     }
     ModelFrames {

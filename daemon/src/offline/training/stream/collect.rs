@@ -4,7 +4,9 @@
 //!
 //! - the mean and covariance of the complete frames ([`Moments`], both halves of each batch
 //!   on the pool, merged in order);
-//! - the frames with gaps to fill, spilled to a temporary file ([`super::spill`]);
+//! - every prepared frame, spilled to a temporary file ([`super::spill`]) for the whitening
+//!   pass (reading it back costs a fraction of reading and preparing the takes again), and
+//!   the frames with gaps to fill, spilled to another;
 //! - the glitch counts, the stabilisation residuals (a bounded, evenly thinned sample), each
 //!   reference marker's residual;
 //! - for the quality report, exactly the frames the in-memory measures read: every
@@ -19,7 +21,7 @@ use ica_core::whiten::Moments;
 use rayon::ThreadPool;
 
 use super::read::{channel_arrays, PreparedTake};
-use super::spill::{f32_bytes, Spill};
+use super::spill::{f32_bytes, f32_values, Spill};
 use crate::offline::training::capture::RefResiduals;
 
 /// Stabilisation residuals kept at most for their median and 95th percentile.
@@ -68,6 +70,8 @@ pub(super) struct Collected {
     pub channels: usize,
     /// Moments of every frame with its mask (frames with gaps offered, not used).
     pub moments: Moments,
+    /// Every prepared frame: `channels` f32 values, then one mask byte per marker.
+    pub prepared: Spill,
     /// Frames with gaps to fill: `channels` f32 values, then `channels` mask bytes.
     pub gappy: Spill,
     /// Per channel, how often it is missing in the frames to fill.
@@ -99,6 +103,7 @@ impl Collected {
         Ok(Self {
             channels: c,
             moments: Moments::new(c),
+            prepared: Spill::new(c * 4 + markers)?,
             gappy: Spill::new(c * 5)?,
             gap_missing: vec![0; c],
             left_out: 0,
@@ -167,9 +172,12 @@ impl Collected {
         let mut block = vec![0.0f64; c];
         let (mut filled, mut index) = (0usize, 0usize);
         let mut record = Vec::new();
+        let mut all = Vec::with_capacity(take.frames * (c * 4 + n));
         for f in 0..take.frames {
             let (x, m) = (&samples[f * c..(f + 1) * c], &mask[f * c..(f + 1) * c]);
             let prepared = &take.missing[f * n..(f + 1) * n];
+            f32_bytes(x, &mut all);
+            all.extend(prepared.iter().map(|&g| u8::from(g)));
             let raw = &take.raw_missing[f * n..(f + 1) * n];
             for (k, (&before, &after)) in raw.iter().zip(prepared).enumerate() {
                 self.glitches_per_marker[k] += usize::from(!before && after);
@@ -212,6 +220,7 @@ impl Collected {
                 filled = 0;
             }
         }
+        self.prepared.push(&all)?;
         self.add_noise(samples, mask, take.frames, noise_stride);
         self.frame += take.frames;
         Ok(())
@@ -229,4 +238,29 @@ impl Collected {
             }
         }
     }
+}
+
+/// Reads the prepared frames back, `chunk` frames at a time, as values and a per-channel mask
+/// (frames x channels each).
+///
+/// # Errors
+/// Reading the spill file, or `each`, fails.
+pub(super) fn for_each_prepared(
+    prepared: &mut Spill,
+    channels: usize,
+    chunk: usize,
+    each: &mut dyn FnMut(&mut Vec<f32>, &mut Vec<bool>) -> Result<()>,
+) -> Result<()> {
+    let n = channels / 3;
+    let (mut values, mut mask, mut frame) = (Vec::new(), Vec::new(), Vec::new());
+    prepared.for_each_chunk(chunk, &mut |bytes| {
+        values.clear();
+        mask.clear();
+        for record in bytes.chunks_exact(4 * channels + n) {
+            f32_values(&record[..4 * channels], &mut frame);
+            values.extend_from_slice(&frame);
+            mask.extend(record[4 * channels..].iter().flat_map(|&g| [g != 0; 3]));
+        }
+        each(&mut values, &mut mask)
+    })
 }

@@ -9,8 +9,8 @@
 //! 2. [`collect`]: every frame prepared once: the moments, the frames with gaps (spilled),
 //!    the glitch counts and what the quality report measures.
 //! 3. [`gaps`]: the gap-filling rounds over the spilled frames only.
-//! 4. [`fit`]: every frame prepared again, gaps filled, whitened and spilled; the restarts on
-//!    the subsample drawn during that pass; FastICA over the whitened spill, one pass per
+//! 4. [`fit`]: the prepared frames read back, gaps filled, whitened and spilled; the restarts
+//!    on the subsample drawn during that pass; FastICA over the whitened spill, one pass per
 //!    iteration.
 //!
 //! Memory: one batch of takes ([`BATCH_FRAMES`] frames, or one take if longer), the sample,
@@ -39,12 +39,14 @@ use super::quality::{self, Measures};
 use super::{residual_summary, PrepReport, Stage, TrainOptions, Trained};
 use crate::offline::progress::Progress;
 use collect::Collected;
-use read::{batches, channel_arrays, for_each_batch, TakePrep};
+use rayon::prelude::*;
+use read::{batches, TakePrep};
 
 /// Sessions of at most this many frames (7 minutes at 120 Hz) train in memory.
 pub const IN_MEMORY_FRAMES: usize = 50_000;
-/// Frames the head and the glitch limits are learned from at most.
-pub const SAMPLE_FRAMES: usize = 50_000;
+/// Frames the head and the glitch limits are learned from at most (about 3 minutes at 120 Hz,
+/// in stretches of 2 s spread over the session).
+pub const SAMPLE_FRAMES: usize = 20_000;
 /// Frames of takes prepared at once.
 const BATCH_FRAMES: u64 = 16_384;
 
@@ -99,11 +101,10 @@ pub fn train_files(
         };
         return super::train(takes, options, &mut stage);
     }
-    streamed(paths, scanned, options, &pool, progress)
+    streamed(scanned, options, &pool, progress)
 }
 
 fn streamed(
-    paths: &[PathBuf],
     scanned: scan::Scan,
     options: &TrainOptions,
     pool: &ThreadPool,
@@ -117,35 +118,50 @@ fn streamed(
         &options.prep,
     )?;
     let total = scanned.total_frames();
-    let prep = TakePrep {
-        labels: &scanned.labels,
-        rate_hz: scanned.rate_hz,
-        capture: &learned.capture,
-    };
-    let sizes: Vec<u64> = scanned.take_frames.iter().map(|&f| f as u64).collect();
-    let batches = batches(&sizes, BATCH_FRAMES);
-    let load = |i: usize| prep.load(&paths[i]);
     // Pass 2: statistics.
     progress.step("statistics", "frames", Some(total as u64));
     let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz)?;
     let mut refs = learned.capture.head.as_ref().map(RefResiduals::new);
-    for_each_batch(pool, &batches, &load, &mut |_, batch| {
+    let prep = TakePrep {
+        kept: &scanned.kept,
+        spilled_markers: scanned.first_markers,
+        rate_hz: scanned.rate_hz,
+        capture: &learned.capture,
+    };
+    let frames = &scanned.take_frames;
+    let sizes: Vec<u64> = frames.iter().map(|&f| f as u64).collect();
+    let batches = batches(&sizes, BATCH_FRAMES);
+    let groups: Vec<usize> = batches.iter().map(|r| frames[r.clone()].iter().sum()).collect();
+    let mut raw = scanned.raw;
+    raw.for_each_group(&groups, &mut |b, bytes| {
+        let record = 13 * scanned.first_markers;
+        let mut starts = vec![0];
+        for &f in &frames[batches[b].clone()] {
+            starts.push(starts.last().copied().unwrap_or(0) + f * record);
+        }
+        let batch = pool.install(|| {
+            starts
+                .par_windows(2)
+                .map(|w| prep.prepare(&bytes[w[0]..w[1]]))
+                .collect::<Result<Vec<_>>>()
+        })?;
         collected.add_batch(&batch, refs.as_mut(), pool)?;
-        progress.advance(batch.iter().map(|t| t.frames as u64).sum());
+        progress.advance(groups[b] as u64);
         Ok(())
     })?;
+    drop(raw);
     let noise_mm = noise_of_differences(&mut collected.noise_d2);
     let params = component_params(options, noise_mm);
     // Pass 3: the gaps.
     let filled = gaps::fill(&mut collected, params.get_components(), pool, progress)?;
-    // Pass 4: whitening, then FastICA over the spill.
+    // Pass 4: the prepared frames, gaps filled, whitened; then FastICA over the spill.
+    let (prepared, c) = (&mut collected.prepared, collected.channels);
     let mut source = |each: &mut dyn FnMut(&[f32], &[bool]) -> Result<()>| {
-        for_each_batch(pool, &batches, &load, &mut |_, batch| {
-            let (mut values, mut mask) = channel_arrays(&batch);
+        collect::for_each_prepared(prepared, c, BATCH_FRAMES as usize, &mut |values, mask| {
             if let Some(model) = &filled.model {
-                fill_batch(model, &filled.seen, &mut values, &mut mask, pool);
+                fill_batch(model, &filled.seen, values, mask, pool);
             }
-            each(&values, &mask)
+            each(values, mask)
         })
     };
     let fit = fit::fit(&params, filled.moments, total, &mut source, pool, progress)?;

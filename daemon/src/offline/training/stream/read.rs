@@ -1,19 +1,19 @@
-//! Reading takes for streaming training: in batches loaded and prepared on the pool, handed to
-//! the caller one batch at a time, in take order, so the passes stay deterministic whatever
-//! the thread count and memory holds one batch.
+//! Reading takes for streaming training: in batches loaded (or read back from the first
+//! pass's spill) and prepared on the pool, handed to the caller one batch at a time, in take
+//! order, so the passes stay deterministic whatever the thread count and memory holds one
+//! batch.
 
 use std::ops::Range;
-use std::path::PathBuf;
-
-use anyhow::{Context, Result};
+use anyhow::Result;
 use ica_core::model::CaptureSettings;
 use rayon::prelude::*;
 use rayon::ThreadPool;
 use replay::Take;
 
+use super::sample::narrow;
+use super::spill::f32_values;
 use crate::engine::frame::FramePrep;
-use crate::engine::layout::LabelMap;
-use crate::offline::{load_take, to_model_order};
+use crate::offline::ModelFrames;
 
 /// Consecutive items whose sizes add up to about `target` (at least one item each).
 pub(super) fn batches(sizes: &[u64], target: u64) -> Vec<Range<usize>> {
@@ -83,24 +83,22 @@ pub(super) struct PreparedTake {
 /// What preparing a take needs: the model's markers, rate and capture settings.
 #[derive(Debug, Clone)]
 pub(super) struct TakePrep<'a> {
-    pub labels: &'a [String],
+    /// The kept markers' indices among the spilled frames' markers.
+    pub kept: &'a [usize],
+    /// Markers of a spilled frame.
+    pub spilled_markers: usize,
     pub rate_hz: f64,
     pub capture: &'a CaptureSettings,
 }
 
 impl TakePrep<'_> {
-    /// Loads `path` at the model rate and prepares every frame.
+    /// Prepares every frame of a take spilled by the first pass ([`super::scan`]).
     ///
     /// # Errors
-    /// Unreadable take, or one that shares no marker with the model.
-    pub(super) fn load(&self, path: &PathBuf) -> Result<PreparedTake> {
-        let original = load_take(path)?;
-        let take = at_rate(&original, self.rate_hz).unwrap_or(original);
-        let map = LabelMap::new(self.labels, &take.labels)
-            .with_context(|| format!("{}", path.display()))?;
-        let raw = to_model_order(&take, &map);
-        drop(take);
-        let n = self.labels.len();
+    /// A frame buffer that does not match the markers (an internal invariant).
+    pub(super) fn prepare(&self, bytes: &[u8]) -> Result<PreparedTake> {
+        let raw = narrow(&self.unspill(bytes), self.kept);
+        let n = self.kept.len();
         let frames = raw.frames();
         let mut prep = FramePrep::new(n, self.rate_hz, self.capture);
         let mut out = PreparedTake {
@@ -123,6 +121,22 @@ impl TakePrep<'_> {
         }
         out.raw_missing = raw.missing;
         Ok(out)
+    }
+
+    /// The spilled frames back as positions and mask.
+    fn unspill(&self, bytes: &[u8]) -> ModelFrames {
+        let n = self.spilled_markers;
+        let (mut xyz, mut missing, mut frame) = (Vec::new(), Vec::new(), Vec::new());
+        for record in bytes.chunks_exact(13 * n) {
+            f32_values(&record[..12 * n], &mut frame);
+            xyz.extend_from_slice(&frame);
+            missing.extend(record[12 * n..].iter().map(|&b| b != 0));
+        }
+        ModelFrames {
+            xyz,
+            missing,
+            markers: n,
+        }
     }
 }
 

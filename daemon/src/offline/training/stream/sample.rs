@@ -45,10 +45,14 @@ impl Sampler {
         }
     }
 
-    /// Offers take number `take`, in the sample's marker order.
-    pub(super) fn push(&mut self, take: usize, frames: &ModelFrames) {
-        let total = frames.frames();
-        let n = frames.markers;
+    /// Offers take number `take` of `total` frames; `gather` gives a range of its frames in
+    /// the sample's marker order (called only for the stretches kept).
+    pub(super) fn push(
+        &mut self,
+        take: usize,
+        total: usize,
+        gather: &dyn Fn(std::ops::Range<usize>) -> ModelFrames,
+    ) {
         for start in (0..total).step_by(SEGMENT_FRAMES) {
             let index = self.next;
             self.next += 1;
@@ -60,11 +64,7 @@ impl Sampler {
                 index,
                 take,
                 start,
-                frames: ModelFrames {
-                    xyz: frames.xyz[start * n * 3..end * n * 3].to_vec(),
-                    missing: frames.missing[start * n..end * n].to_vec(),
-                    markers: n,
-                },
+                frames: gather(start..end),
             });
             self.kept_frames += end - start;
             while self.kept_frames > self.budget {
@@ -102,8 +102,18 @@ impl Sampler {
     }
 }
 
+/// Frames `range` of `frames`.
+pub(super) fn frames_range(frames: &ModelFrames, range: std::ops::Range<usize>) -> ModelFrames {
+    let n = frames.markers;
+    ModelFrames {
+        xyz: frames.xyz[range.start * n * 3..range.end * n * 3].to_vec(),
+        missing: frames.missing[range.start * n..range.end * n].to_vec(),
+        markers: n,
+    }
+}
+
 /// `frames` with only `markers`, in that order.
-fn narrow(frames: &ModelFrames, markers: &[usize]) -> ModelFrames {
+pub(super) fn narrow(frames: &ModelFrames, markers: &[usize]) -> ModelFrames {
     let n = frames.markers;
     let count = frames.frames();
     let mut xyz = Vec::with_capacity(count * markers.len() * 3);
@@ -133,12 +143,20 @@ mod tests {
         }
     }
 
+    fn push(s: &mut Sampler, i: usize, t: &ModelFrames) {
+        s.push(i, t.frames(), &|r| ModelFrames {
+            xyz: t.xyz[r.start * 3..r.end * 3].to_vec(),
+            missing: t.missing[r].to_vec(),
+            markers: 1,
+        });
+    }
+
     #[test]
     fn a_session_within_the_budget_comes_back_whole() {
         let mut s = Sampler::new(10_000);
         let takes = [take(500, 0.0), take(37, 1e5), take(1_000, 2e5)];
         for (i, t) in takes.iter().enumerate() {
-            s.push(i, t);
+            push(&mut s, i, t);
         }
         let out = s.finish(&[0]);
         assert_eq!(out.len(), 3);
@@ -151,7 +169,7 @@ mod tests {
     fn a_long_session_is_sampled_evenly_within_the_budget() {
         let mut s = Sampler::new(5_000);
         for i in 0..400 {
-            s.push(i, &take(1_000, i as f32 * 1e4));
+            push(&mut s, i, &take(1_000, i as f32 * 1e4));
         }
         let stride = s.stride;
         let out = s.finish(&[0]);

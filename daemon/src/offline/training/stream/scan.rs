@@ -1,8 +1,9 @@
 //! The first pass of streaming training: every take read once for what must be known before
 //! any frame is prepared. The model rate, each take's frame count, how often each marker is
 //! missing (which markers the model keeps) and a bounded sample of the capture
-//! ([`super::sample`]). A session no longer than the in-memory limit is kept whole, for the
-//! in-memory path.
+//! ([`super::sample`]). The frames, at the model rate in the first take's marker order, go to
+//! a spill file, so the next pass reads them back instead of decoding every file again. A
+//! session no longer than the in-memory limit is kept whole, for the in-memory path.
 
 use std::path::PathBuf;
 
@@ -10,11 +11,13 @@ use anyhow::{Context, Result};
 use rayon::ThreadPool;
 
 use super::read::{at_rate, batches, for_each_batch};
-use super::sample::Sampler;
+use super::sample::{frames_range, Sampler};
+use super::spill::{f32_bytes, Spill};
 use crate::engine::layout::LabelMap;
 use crate::offline::progress::Progress;
 use crate::offline::training::{MissingCounts, PrepOptions};
-use crate::offline::{load_take, to_model_order, LoadedTake, ModelFrames};
+use crate::offline::takes::frames_in_model_order;
+use crate::offline::{load_take, LoadedTake, ModelFrames};
 
 /// Bytes of take files loaded at once in the first pass.
 const SCAN_BATCH_BYTES: u64 = 64 << 20;
@@ -34,6 +37,13 @@ pub(super) struct Scan {
     pub take_frames: Vec<usize>,
     /// The bounded sample, in the kept markers' order.
     pub sample: Vec<ModelFrames>,
+    /// Markers of the first take (the order of the spilled frames).
+    pub first_markers: usize,
+    /// The kept markers' indices among the first take's.
+    pub kept: Vec<usize>,
+    /// Every frame at the model rate in the first take's marker order: positions (f32), then
+    /// one missing byte per marker.
+    pub raw: Spill,
     /// Every take as loaded, when the session is within the in-memory limit.
     pub held: Option<Vec<LoadedTake>>,
 }
@@ -74,8 +84,12 @@ pub(super) fn scan(
         resampled: Vec::new(),
         take_frames: Vec::with_capacity(paths.len()),
         sample: Vec::new(),
+        first_markers: first_labels.len(),
+        kept: Vec::new(),
+        raw: Spill::new(first_labels.len() * 13)?,
         held: Some(Vec::new()),
     };
+    let mut bytes = Vec::new();
     let sizes: Vec<u64> = paths
         .iter()
         .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
@@ -102,7 +116,15 @@ pub(super) fn scan(
                     .with_context(|| format!("{}", path.display()))?;
                 let map = LabelMap::new(&first_labels, &take.labels)
                     .with_context(|| format!("{}", path.display()))?;
-                sampler.push(i, &to_model_order(&take, &map));
+                let all = frames_in_model_order(take, &map, 0..take.n_frames());
+                sampler.push(i, all.frames(), &|r| frames_range(&all, r));
+                bytes.clear();
+                for f in 0..all.frames() {
+                    let (xyz, missing) = all.frame(f);
+                    f32_bytes(xyz, &mut bytes);
+                    bytes.extend(missing.iter().map(|&m| u8::from(m)));
+                }
+                scan.raw.push(&bytes)?;
                 scan.take_frames.push(take.n_frames());
                 scan.held = match scan.held.take() {
                     Some(mut held) if scan.take_frames.iter().sum::<usize>() <= hold_frames => {
@@ -131,7 +153,9 @@ pub(super) fn scan(
         })
         .collect();
     scan.sample = sampler.finish(&kept);
+    scan.kept = kept;
     scan.labels = labels;
     scan.excluded = excluded;
     Ok(scan)
 }
+

@@ -54,6 +54,35 @@ impl Spill {
         Ok(())
     }
 
+    /// Reads every record back in order, in groups of `groups[i]` records (which must add up
+    /// to the records written).
+    ///
+    /// # Errors
+    /// Reading fails, or `each` does.
+    pub(super) fn for_each_group(
+        &mut self,
+        groups: &[usize],
+        each: &mut dyn FnMut(usize, &[u8]) -> Result<()>,
+    ) -> Result<()> {
+        debug_assert_eq!(groups.iter().sum::<usize>(), self.records);
+        self.file.flush().context("cannot write the spill file")?;
+        let file = self.file.get_mut();
+        file.seek(SeekFrom::Start(0))
+            .context("cannot read the spill file")?;
+        let mut reader = BufReader::with_capacity(1 << 20, &*file);
+        for (i, &n) in groups.iter().enumerate() {
+            self.buffer.resize(n * self.record_bytes, 0);
+            reader
+                .read_exact(&mut self.buffer)
+                .context("cannot read the spill file")?;
+            each(i, &self.buffer)?;
+        }
+        drop(reader);
+        file.seek(SeekFrom::End(0))
+            .context("cannot write the spill file")?;
+        Ok(())
+    }
+
     /// Reads every record back in order, `chunk_records` at a time.
     ///
     /// # Errors
@@ -63,25 +92,12 @@ impl Spill {
         chunk_records: usize,
         each: &mut dyn FnMut(&[u8]) -> Result<()>,
     ) -> Result<()> {
-        self.file.flush().context("cannot write the spill file")?;
-        let file = self.file.get_mut();
-        file.seek(SeekFrom::Start(0))
-            .context("cannot read the spill file")?;
-        let mut reader = BufReader::with_capacity(1 << 20, &*file);
-        let mut left = self.records;
-        while left > 0 {
-            let n = left.min(chunk_records.max(1));
-            self.buffer.resize(n * self.record_bytes, 0);
-            reader
-                .read_exact(&mut self.buffer)
-                .context("cannot read the spill file")?;
-            each(&self.buffer)?;
-            left -= n;
+        let chunk = chunk_records.max(1);
+        let mut groups = vec![chunk; self.records / chunk];
+        if self.records % chunk > 0 {
+            groups.push(self.records % chunk);
         }
-        drop(reader);
-        file.seek(SeekFrom::End(0))
-            .context("cannot write the spill file")?;
-        Ok(())
+        self.for_each_group(&groups, &mut |_, bytes| each(bytes))
     }
 }
 
