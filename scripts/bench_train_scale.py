@@ -84,7 +84,7 @@ def report(path):
               f"session / smallest: {per[-1] / per[0]:.3f}")
     for size, r in one.items():
         two = statistics.median(x[0] for x in train[size])
-        print(f"{size} on one thread: {r[0]:.2f} s ({two / r[0]:.2f}x the time on all cores)")
+        print(f"{size} on one thread: {r[0]:.2f} s; on all cores {two:.2f} s ({r[0] / two:.2f}x speed-up)")
     if "12k" in train and "12k" in sk:
         ours = statistics.median(r[0] for r in train["12k"])
         theirs = statistics.median(r[0] for r in sk["12k"])

@@ -60,13 +60,23 @@ fn assert_same_model(a: &Trained, b: &Trained, tol: f64) {
     assert_eq!(a.data.glitches, b.data.glitches);
     assert_eq!(a.data.residual_summary, b.data.residual_summary);
     for (x, y) in ra.eigenvalues.iter().zip(&rb.eigenvalues) {
-        assert!((x - y).abs() <= 1e-9 * ra.eigenvalues[0], "eigenvalue {x} vs {y}");
+        assert!(
+            (x - y).abs() <= 1e-9 * ra.eigenvalues[0],
+            "eigenvalue {x} vs {y}"
+        );
     }
     let scale = ma.mixing().amax();
     let diff = (ma.mixing() - mb.mixing()).amax();
-    assert!(diff <= tol * scale, "mixing differs by {diff:e} (scale {scale})");
+    assert!(
+        diff <= tol * scale,
+        "mixing differs by {diff:e} (scale {scale})"
+    );
     let (qa, qb) = (ma.quality(), mb.quality());
-    for (x, y) in qa.residual_by_marker_mm.iter().zip(&qb.residual_by_marker_mm) {
+    for (x, y) in qa
+        .residual_by_marker_mm
+        .iter()
+        .zip(&qb.residual_by_marker_mm)
+    {
         assert!((x - y).abs() < 1e-3, "residual {x} vs {y}");
     }
     assert_eq!(qa.head, qb.head);
@@ -92,7 +102,11 @@ fn issue_18_streaming_matches_in_memory_on_animface_and_threads_do_not_change_it
     let one = streamed(&paths, &options, 1);
     let two = streamed(&paths, &options, 2);
     assert_same_model(&a, &two, 1e-4);
-    assert_eq!(one.model.mixing(), two.model.mixing(), "threads changed the model");
+    assert_eq!(
+        one.model.mixing(),
+        two.model.mixing(),
+        "threads changed the model"
+    );
     assert_eq!(one.model.mean(), two.model.mean());
 }
 
@@ -101,7 +115,15 @@ fn issue_18_train_shows_progress_in_a_pipe() {
     let dir = tempfile::tempdir().expect("temp dir");
     let model = dir.path().join("model.json");
     let take = facial_sing().remove(0);
-    let out = run(&["train", "--stream", "--threads", "1", "--out", s(&model), s(&take)]);
+    let out = run(&[
+        "train",
+        "--stream",
+        "--threads",
+        "1",
+        "--out",
+        s(&model),
+        s(&take),
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     for line in [

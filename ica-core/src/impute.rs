@@ -140,7 +140,13 @@ pub struct GapModel {
 
 impl GapModel {
     fn new(w: &whiten::Whitening, channels: usize) -> GapModel {
-        Self::from_parts(&w.mean, &w.live_channels, &w.basis, &w.eigenvalues, channels)
+        Self::from_parts(
+            &w.mean,
+            &w.live_channels,
+            &w.basis,
+            &w.eigenvalues,
+            channels,
+        )
     }
 
     /// The model of a fitted whitening (a streamed PCA), as [`fill_gaps`] builds it from an

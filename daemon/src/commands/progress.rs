@@ -121,6 +121,17 @@ impl<W: Write> Lines<W> {
         let secs = s.started.elapsed().as_secs_f64();
         let rate = s.done as f64 / secs.max(1e-9);
         // Progress lines are best effort: a closed stderr must not fail the work.
+        if s.done == 0 && s.total.is_none() {
+            // A step that counts nothing (restarts in memory): its time is what there is.
+            let _ = writeln!(
+                self.out,
+                "{}: {} done in {secs:.1} s{}",
+                self.command,
+                s.name,
+                note(&self.note)
+            );
+            return;
+        }
         let _ = writeln!(
             self.out,
             "{}: {} done: {} {} in {secs:.1} s ({} {}/s){}",
@@ -227,6 +238,7 @@ mod tests {
         lines.note("12 gappy frames");
         lines.step("refinement", "iterations", None);
         lines.advance(3);
+        lines.step("restarts", "restarts", None);
         lines.finish();
         let text = String::from_utf8(lines.into_inner()).expect("utf-8");
         let rows: Vec<&str> = text.lines().collect();
@@ -236,11 +248,22 @@ mod tests {
             "{text}"
         );
         assert!(rows[1].contains("frames/s"), "{text}");
-        assert!(rows[2].starts_with("train: statistics done: 250 frames in "), "{text}");
+        assert!(
+            rows[2].starts_with("train: statistics done: 250 frames in "),
+            "{text}"
+        );
         assert!(rows[2].ends_with("[12 gappy frames]"), "{text}");
         assert_eq!(rows[3], "train: refinement");
-        assert!(rows[4].starts_with("train: refinement: 3 iterations, "), "{text}");
-        assert!(rows[5].starts_with("train: refinement done: 3 iterations"), "{text}");
-        assert_eq!(rows.len(), 6);
+        assert!(
+            rows[4].starts_with("train: refinement: 3 iterations, "),
+            "{text}"
+        );
+        assert!(
+            rows[5].starts_with("train: refinement done: 3 iterations"),
+            "{text}"
+        );
+        assert_eq!(rows[6], "train: restarts");
+        assert!(rows[7].starts_with("train: restarts done in "), "{text}");
+        assert_eq!(rows.len(), 8);
     }
 }

@@ -157,7 +157,12 @@ pub(crate) fn train_and_save(
 }
 
 /// Writes the model to `out` and prints what training found.
-fn save_and_print(trained: Trained, takes: usize, out: &Path, started: Instant) -> Result<IcaModel> {
+fn save_and_print(
+    trained: Trained,
+    takes: usize,
+    out: &Path,
+    started: Instant,
+) -> Result<IcaModel> {
     let Trained {
         model,
         data,

@@ -176,14 +176,16 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         start += f.frames();
     }
     let learned = capture::learn(&frames, &labels, rate_hz, options)?;
-    let (capture, reference, mut head_report) =
-        (learned.capture, learned.reference, learned.head);
+    let (capture, reference, mut head_report) = (learned.capture, learned.reference, learned.head);
     let (samples, marker_missing, glitches, residuals_mm) =
         run_prep(&frames, n, rate_hz, &capture)?;
     let per_marker = glitches_per_marker(&frames, &marker_missing, n);
     if let Some(h) = &capture.head {
         let mut sums = RefResiduals::new(h);
-        for (xyz, missing) in samples.chunks_exact(n * 3).zip(marker_missing.chunks_exact(n)) {
+        for (xyz, missing) in samples
+            .chunks_exact(n * 3)
+            .zip(marker_missing.chunks_exact(n))
+        {
             sums.add_frame(xyz, missing);
         }
         head_report.residual_mm = sums.by_label(&labels);

@@ -139,7 +139,12 @@ impl Collected {
         let mut at = 0;
         for take in batch {
             let end = at + take.frames;
-            self.add_take(take, &samples[at * self.channels..end * self.channels], &mask[at * self.channels..end * self.channels], refs.as_deref_mut())?;
+            self.add_take(
+                take,
+                &samples[at * self.channels..end * self.channels],
+                &mask[at * self.channels..end * self.channels],
+                refs.as_deref_mut(),
+            )?;
             at = end;
         }
         let c = self.channels;
@@ -192,12 +197,16 @@ impl Collected {
             }
             match gaps {
                 FrameGaps::Complete => {
-                    block.iter_mut().zip(x).for_each(|(b, &v)| *b += f64::from(v));
+                    block
+                        .iter_mut()
+                        .zip(x)
+                        .for_each(|(b, &v)| *b += f64::from(v));
                     filled += 1;
                     if filled == self.slow_block {
                         if index % block_stride == 0 {
                             let scale = 1.0 / self.slow_block as f64;
-                            self.slow_means.push(block.iter().map(|b| b * scale).collect());
+                            self.slow_means
+                                .push(block.iter().map(|b| b * scale).collect());
                         }
                         index += 1;
                         block.fill(0.0);
@@ -240,6 +249,10 @@ impl Collected {
     }
 }
 
+/// Takes a batch of frames: values and the per-channel mask (frames x channels each), which it
+/// may change in place.
+pub(super) type FrameSink<'a> = dyn FnMut(&mut Vec<f32>, &mut Vec<bool>) -> Result<()> + 'a;
+
 /// Reads the prepared frames back, `chunk` frames at a time, as values and a per-channel mask
 /// (frames x channels each).
 ///
@@ -249,7 +262,7 @@ pub(super) fn for_each_prepared(
     prepared: &mut Spill,
     channels: usize,
     chunk: usize,
-    each: &mut dyn FnMut(&mut Vec<f32>, &mut Vec<bool>) -> Result<()>,
+    each: &mut FrameSink<'_>,
 ) -> Result<()> {
     let n = channels / 3;
     let (mut values, mut mask, mut frame) = (Vec::new(), Vec::new(), Vec::new());
@@ -263,4 +276,26 @@ pub(super) fn for_each_prepared(
         }
         each(&mut values, &mut mask)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thinned_keeps_a_short_stream_whole_and_a_long_one_within_its_limit() {
+        let mut short = Thinned::new(100);
+        (0..100).for_each(|v| short.push(f64::from(v)));
+        assert_eq!(short.values.len(), 100);
+        let mut long = Thinned::new(100);
+        (0..1_000_000).for_each(|v| long.push(f64::from(v)));
+        assert!(
+            (50..=100).contains(&long.values.len()),
+            "{}",
+            long.values.len()
+        );
+        // Evenly spread: every kept value is a multiple of the final stride.
+        assert!(long.values.iter().all(|v| *v as usize % long.stride == 0));
+        assert!(*long.values.last().expect("kept") > 900_000.0);
+    }
 }

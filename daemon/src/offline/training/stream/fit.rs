@@ -14,10 +14,11 @@ use crate::offline::progress::Progress;
 /// Whitened frames read back at once.
 const CHUNK_FRAMES: usize = 32_768;
 
-/// Calls its argument with every prepared frame, in batches: values and the per-channel mask,
-/// frames x channels each.
-pub(super) type WhitenSource<'a> =
-    dyn FnMut(&mut dyn FnMut(&[f32], &[bool]) -> Result<()>) -> Result<()> + 'a;
+/// Takes a batch of prepared frames: values and the per-channel mask, frames x channels each.
+pub(super) type FrameBatch<'a> = dyn FnMut(&[f32], &[bool]) -> Result<()> + 'a;
+
+/// Calls its argument with every prepared frame, in batches.
+pub(super) type WhitenSource<'a> = dyn FnMut(&mut FrameBatch<'_>) -> Result<()> + 'a;
 
 /// Fits `params` to the frames `source` gives, whose statistics are `moments`.
 ///
@@ -52,7 +53,11 @@ pub(super) fn fit(
                 progress.advance(1);
             }
             Pass::Sources => {
-                progress.step("components' statistics", "frames", Some(store.records() as u64));
+                progress.step(
+                    "components' statistics",
+                    "frames",
+                    Some(store.records() as u64),
+                );
                 let empty = fit.source_moments()?;
                 let mut sums = empty.clone();
                 let map = |z: &[f32]| {

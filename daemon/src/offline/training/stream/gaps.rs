@@ -62,8 +62,8 @@ pub(super) fn fill(
             report,
         });
     }
-    let mut pca = Whitener::from_moments(&collected.moments, components)
-        .context("training failed")?;
+    let mut pca =
+        Whitener::from_moments(&collected.moments, components).context("training failed")?;
     for round in 0..EM_ITERATIONS {
         progress.step(
             &format!("filling gaps, round {}/{EM_ITERATIONS}", round + 1),
@@ -110,32 +110,30 @@ fn filled_moments(
     let c = collected.channels;
     let mut total = Moments::new(c);
     let (mut values, mut mask) = (Vec::new(), Vec::new());
-    collected
-        .gappy
-        .for_each_chunk(CHUNK_FRAMES, &mut |bytes| {
-            let frames = bytes.len() / (5 * c);
-            values.clear();
-            mask.clear();
-            for record in bytes.chunks_exact(5 * c) {
-                let mut x = Vec::new();
-                f32_values(&record[..4 * c], &mut x);
-                values.extend_from_slice(&x);
-                mask.extend(record[4 * c..].iter().map(|&b| b != 0));
-            }
-            let mid = frames / 2;
-            let (vl, vr) = values.split_at_mut(mid * c);
-            let (ml, mr) = mask.split_at_mut(mid * c);
-            let half = |v: &mut [f32], m: &mut [bool]| -> Result<Moments> {
-                fill_frames(model, seen, v, m);
-                let mut acc = Moments::new(c);
-                acc.add_chunk(&FitData::new(&*v, c)?.with_missing(&*m)?)?;
-                Ok(acc)
-            };
-            let (left, right) = pool.join(|| half(vl, ml), || half(vr, mr));
-            total.merge(left?)?;
-            total.merge(right?)?;
-            progress.advance(frames as u64);
-            Ok(())
-        })?;
+    collected.gappy.for_each_chunk(CHUNK_FRAMES, &mut |bytes| {
+        let frames = bytes.len() / (5 * c);
+        values.clear();
+        mask.clear();
+        for record in bytes.chunks_exact(5 * c) {
+            let mut x = Vec::new();
+            f32_values(&record[..4 * c], &mut x);
+            values.extend_from_slice(&x);
+            mask.extend(record[4 * c..].iter().map(|&b| b != 0));
+        }
+        let mid = frames / 2;
+        let (vl, vr) = values.split_at_mut(mid * c);
+        let (ml, mr) = mask.split_at_mut(mid * c);
+        let half = |v: &mut [f32], m: &mut [bool]| -> Result<Moments> {
+            fill_frames(model, seen, v, m);
+            let mut acc = Moments::new(c);
+            acc.add_chunk(&FitData::new(&*v, c)?.with_missing(&*m)?)?;
+            Ok(acc)
+        };
+        let (left, right) = pool.join(|| half(vl, ml), || half(vr, mr));
+        total.merge(left?)?;
+        total.merge(right?)?;
+        progress.advance(frames as u64);
+        Ok(())
+    })?;
     Ok(total)
 }

@@ -26,6 +26,7 @@ mod sample;
 mod scan;
 mod spill;
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
@@ -51,21 +52,12 @@ pub const SAMPLE_FRAMES: usize = 20_000;
 const BATCH_FRAMES: u64 = 16_384;
 
 /// How streaming training runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct StreamOptions {
     /// Threads of the pool (0: one per core).
     pub threads: usize,
     /// Stream even a session short enough to train in memory.
     pub always_stream: bool,
-}
-
-impl Default for StreamOptions {
-    fn default() -> Self {
-        Self {
-            threads: 0,
-            always_stream: false,
-        }
-    }
 }
 
 /// Trains a model on the takes in `paths`, streaming them unless the session is short (see
@@ -118,45 +110,15 @@ fn streamed(
         &options.prep,
     )?;
     let total = scanned.total_frames();
-    // Pass 2: statistics.
-    progress.step("statistics", "frames", Some(total as u64));
-    let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz)?;
-    let mut refs = learned.capture.head.as_ref().map(RefResiduals::new);
-    let prep = TakePrep {
-        kept: &scanned.kept,
-        spilled_markers: scanned.first_markers,
-        rate_hz: scanned.rate_hz,
-        capture: &learned.capture,
-    };
-    let frames = &scanned.take_frames;
-    let sizes: Vec<u64> = frames.iter().map(|&f| f as u64).collect();
-    let batches = batches(&sizes, BATCH_FRAMES);
-    let groups: Vec<usize> = batches.iter().map(|r| frames[r.clone()].iter().sum()).collect();
-    let mut raw = scanned.raw;
-    raw.for_each_group(&groups, &mut |b, bytes| {
-        let record = 13 * scanned.first_markers;
-        let mut starts = vec![0];
-        for &f in &frames[batches[b].clone()] {
-            starts.push(starts.last().copied().unwrap_or(0) + f * record);
-        }
-        let batch = pool.install(|| {
-            starts
-                .par_windows(2)
-                .map(|w| prep.prepare(&bytes[w[0]..w[1]]))
-                .collect::<Result<Vec<_>>>()
-        })?;
-        collected.add_batch(&batch, refs.as_mut(), pool)?;
-        progress.advance(groups[b] as u64);
-        Ok(())
-    })?;
-    drop(raw);
+    let (scanned, raw) = scanned.take_raw()?;
+    let (mut collected, head_residuals) = statistics(&scanned, raw, &learned, pool, progress)?;
     let noise_mm = noise_of_differences(&mut collected.noise_d2);
     let params = component_params(options, noise_mm);
     // Pass 3: the gaps.
     let filled = gaps::fill(&mut collected, params.get_components(), pool, progress)?;
     // Pass 4: the prepared frames, gaps filled, whitened; then FastICA over the spill.
     let (prepared, c) = (&mut collected.prepared, collected.channels);
-    let mut source = |each: &mut dyn FnMut(&[f32], &[bool]) -> Result<()>| {
+    let mut source = |each: &mut fit::FrameBatch<'_>| {
         collect::for_each_prepared(prepared, c, BATCH_FRAMES as usize, &mut |values, mask| {
             if let Some(model) = &filled.model {
                 fill_batch(model, &filled.seen, values, mask, pool);
@@ -176,8 +138,8 @@ fn streamed(
     .context("the fitted model failed validation")?;
     model.set_capture(learned.capture.clone())?;
     let mut head = learned.head.clone();
-    if let Some(r) = &refs {
-        head.residual_mm = r.by_label(&scanned.labels);
+    if let Some(residuals) = head_residuals {
+        head.residual_mm = residuals;
     }
     let c = collected.channels;
     let measures = Measures {
@@ -218,6 +180,51 @@ fn streamed(
         noise_mm,
         capped_at_noise,
     })
+}
+
+/// Pass 2: every spilled frame prepared and collected; each reference marker's residual.
+fn statistics(
+    scanned: &scan::Scan,
+    mut raw: spill::Spill,
+    learned: &capture::Learned,
+    pool: &ThreadPool,
+    progress: &mut dyn Progress,
+) -> Result<(Collected, Option<BTreeMap<String, f64>>)> {
+    let total = scanned.total_frames();
+    progress.step("statistics", "frames", Some(total as u64));
+    let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz)?;
+    let mut refs = learned.capture.head.as_ref().map(RefResiduals::new);
+    let prep = TakePrep {
+        kept: &scanned.kept,
+        spilled_markers: scanned.first_markers,
+        rate_hz: scanned.rate_hz,
+        capture: &learned.capture,
+    };
+    let frames = &scanned.take_frames;
+    let sizes: Vec<u64> = frames.iter().map(|&f| f as u64).collect();
+    let batches = batches(&sizes, BATCH_FRAMES);
+    let groups: Vec<usize> = batches
+        .iter()
+        .map(|r| frames[r.clone()].iter().sum())
+        .collect();
+    let record = 13 * scanned.first_markers;
+    raw.for_each_group(&groups, &mut |b, bytes| {
+        let mut starts = vec![0];
+        for &f in &frames[batches[b].clone()] {
+            starts.push(starts.last().copied().unwrap_or(0) + f * record);
+        }
+        let batch = pool.install(|| {
+            starts
+                .par_windows(2)
+                .map(|w| prep.prepare(&bytes[w[0]..w[1]]))
+                .collect::<Result<Vec<_>>>()
+        })?;
+        collected.add_batch(&batch, refs.as_mut(), pool)?;
+        progress.advance(groups[b] as u64);
+        Ok(())
+    })?;
+    let residuals = refs.map(|r| r.by_label(&scanned.labels));
+    Ok((collected, residuals))
 }
 
 /// Fills the gaps of a batch's frames that have some (as [`collect`] spilled them).

@@ -3,12 +3,12 @@
 //! order, so the passes stay deterministic whatever the thread count and memory holds one
 //! batch.
 
-use std::ops::Range;
 use anyhow::Result;
 use ica_core::model::CaptureSettings;
 use rayon::prelude::*;
 use rayon::ThreadPool;
 use replay::Take;
+use std::ops::Range;
 
 use super::sample::narrow;
 use super::spill::f32_values;

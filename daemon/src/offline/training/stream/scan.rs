@@ -15,8 +15,8 @@ use super::sample::{frames_range, Sampler};
 use super::spill::{f32_bytes, Spill};
 use crate::engine::layout::LabelMap;
 use crate::offline::progress::Progress;
-use crate::offline::training::{MissingCounts, PrepOptions};
 use crate::offline::takes::frames_in_model_order;
+use crate::offline::training::{MissingCounts, PrepOptions};
 use crate::offline::{load_take, LoadedTake, ModelFrames};
 
 /// Bytes of take files loaded at once in the first pass.
@@ -42,13 +42,19 @@ pub(super) struct Scan {
     /// The kept markers' indices among the first take's.
     pub kept: Vec<usize>,
     /// Every frame at the model rate in the first take's marker order: positions (f32), then
-    /// one missing byte per marker.
-    pub raw: Spill,
+    /// one missing byte per marker (taken out by [`Scan::take_raw`]).
+    pub raw: Option<Spill>,
     /// Every take as loaded, when the session is within the in-memory limit.
     pub held: Option<Vec<LoadedTake>>,
 }
 
 impl Scan {
+    /// The spilled frames, taken out (the rest of the scan stays usable).
+    pub(super) fn take_raw(mut self) -> Result<(Self, Spill)> {
+        let raw = self.raw.take().context("the frames were spilled once")?;
+        Ok((self, raw))
+    }
+
     /// Frames in the session.
     pub(super) fn total_frames(&self) -> usize {
         self.take_frames.iter().sum()
@@ -86,10 +92,11 @@ pub(super) fn scan(
         sample: Vec::new(),
         first_markers: first_labels.len(),
         kept: Vec::new(),
-        raw: Spill::new(first_labels.len() * 13)?,
+        raw: None,
         held: Some(Vec::new()),
     };
     let mut bytes = Vec::new();
+    let mut raw = Spill::new(first_labels.len() * 13)?;
     let sizes: Vec<u64> = paths
         .iter()
         .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
@@ -124,7 +131,7 @@ pub(super) fn scan(
                     f32_bytes(xyz, &mut bytes);
                     bytes.extend(missing.iter().map(|&m| u8::from(m)));
                 }
-                scan.raw.push(&bytes)?;
+                raw.push(&bytes)?;
                 scan.take_frames.push(take.n_frames());
                 scan.held = match scan.held.take() {
                     Some(mut held) if scan.take_frames.iter().sum::<usize>() <= hold_frames => {
@@ -152,10 +159,10 @@ pub(super) fn scan(
                 .expect("kept labels come from the first take's")
         })
         .collect();
+    scan.raw = Some(raw);
     scan.sample = sampler.finish(&kept);
     scan.kept = kept;
     scan.labels = labels;
     scan.excluded = excluded;
     Ok(scan)
 }
-
