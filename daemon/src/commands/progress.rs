@@ -1,6 +1,8 @@
 //! Drawing [`Progress`]: a bar on a terminal (indicatif), and in a pipe or a log a line on
-//! stderr when a step starts, every [`LINE_INTERVAL`] while it runs (done, total, rate, ETA)
-//! and when it ends, so a job run under `nohup` or CI shows where it is.
+//! stderr every [`LINE_INTERVAL`] while a step runs (done, total, rate, ETA) and one when it
+//! ends, so a job run under `nohup` or CI shows where it is. Work shorter than the interval
+//! prints nothing (a failure stays the one line on stderr), and neither does an abandoned step.
+//! `EMOSHIFT_PROGRESS_SECS` sets the interval (0: every step and advance).
 
 use std::io::{IsTerminal, Write};
 use std::time::{Duration, Instant};
@@ -15,10 +17,14 @@ pub const LINE_INTERVAL: Duration = Duration::from_secs(5);
 /// The progress display of a command: a bar on a terminal, lines otherwise.
 pub fn for_stderr(command: &'static str) -> Box<dyn Progress> {
     if std::io::stderr().is_terminal() {
-        Box::new(Bar::new(command))
-    } else {
-        Box::new(Lines::new(command, std::io::stderr(), LINE_INTERVAL))
+        return Box::new(Bar::new(command));
     }
+    let interval = std::env::var("EMOSHIFT_PROGRESS_SECS")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .map_or(LINE_INTERVAL, Duration::from_secs_f64);
+    Box::new(Lines::new(command, std::io::stderr(), interval))
 }
 
 /// An indicatif bar per step (a spinner when the total is unknown).
@@ -75,14 +81,20 @@ impl Progress for Bar {
             bar.finish_and_clear();
         }
     }
+
+    fn abandon(&mut self) {
+        self.finish();
+    }
 }
 
-/// Plain lines: a step's start, its state every `interval`, its end.
+/// Plain lines: a step's state every `interval`, and its end.
 #[derive(Debug)]
 pub struct Lines<W: Write> {
     command: &'static str,
     out: W,
     interval: Duration,
+    /// Nothing is printed before this: short work stays quiet.
+    quiet_until: Instant,
     step: Option<Step>,
     note: String,
 }
@@ -104,6 +116,7 @@ impl<W: Write> Lines<W> {
             command,
             out,
             interval,
+            quiet_until: Instant::now() + interval,
             step: None,
             note: String::new(),
         }
@@ -118,6 +131,9 @@ impl<W: Write> Lines<W> {
         let Some(s) = self.step.take() else {
             return;
         };
+        if Instant::now() < self.quiet_until {
+            return;
+        }
         let secs = s.started.elapsed().as_secs_f64();
         let rate = s.done as f64 / secs.max(1e-9);
         // Progress lines are best effort: a closed stderr must not fail the work.
@@ -192,8 +208,6 @@ impl<W: Write> Progress for Lines<W> {
     fn step(&mut self, name: &str, unit: &'static str, total: Option<u64>) {
         self.end_step();
         self.note.clear();
-        let of = total.map_or(String::new(), |t| format!(" ({} {unit})", HumanCount(t)));
-        let _ = writeln!(self.out, "{}: {name}{of}", self.command);
         let now = Instant::now();
         self.step = Some(Step {
             name: name.to_string(),
@@ -210,7 +224,7 @@ impl<W: Write> Progress for Lines<W> {
             return;
         };
         s.done += n;
-        if s.last_line.elapsed() >= self.interval {
+        if s.last_line.elapsed() >= self.interval && Instant::now() >= self.quiet_until {
             s.last_line = Instant::now();
             self.line();
         }
@@ -223,6 +237,10 @@ impl<W: Write> Progress for Lines<W> {
 
     fn finish(&mut self) {
         self.end_step();
+    }
+
+    fn abandon(&mut self) {
+        self.step = None;
     }
 }
 
@@ -239,31 +257,35 @@ mod tests {
         lines.step("refinement", "iterations", None);
         lines.advance(3);
         lines.step("restarts", "restarts", None);
-        lines.finish();
+        lines.step("whitening", "frames", Some(10));
+        lines.advance(4);
+        lines.abandon();
         let text = String::from_utf8(lines.into_inner()).expect("utf-8");
         let rows: Vec<&str> = text.lines().collect();
-        assert_eq!(rows[0], "train: statistics (1,000 frames)");
         assert!(
-            rows[1].starts_with("train: statistics: 250 / 1,000 frames (25 %), ETA "),
+            rows[0].starts_with("train: statistics: 250 / 1,000 frames (25 %), ETA "),
             "{text}"
         );
-        assert!(rows[1].contains("frames/s"), "{text}");
+        assert!(rows[0].contains("frames/s"), "{text}");
         assert!(
-            rows[2].starts_with("train: statistics done: 250 frames in "),
+            rows[1].starts_with("train: statistics done: 250 frames in "),
             "{text}"
         );
-        assert!(rows[2].ends_with("[12 gappy frames]"), "{text}");
-        assert_eq!(rows[3], "train: refinement");
+        assert!(rows[1].ends_with("[12 gappy frames]"), "{text}");
         assert!(
-            rows[4].starts_with("train: refinement: 3 iterations, "),
+            rows[2].starts_with("train: refinement: 3 iterations, "),
             "{text}"
         );
         assert!(
-            rows[5].starts_with("train: refinement done: 3 iterations"),
+            rows[3].starts_with("train: refinement done: 3 iterations"),
             "{text}"
         );
-        assert_eq!(rows[6], "train: restarts");
-        assert!(rows[7].starts_with("train: restarts done in "), "{text}");
-        assert_eq!(rows.len(), 8);
+        assert!(rows[4].starts_with("train: restarts done in "), "{text}");
+        // The abandoned step printed its state, never that it was done.
+        assert!(
+            rows[5].starts_with("train: whitening: 4 / 10 frames"),
+            "{text}"
+        );
+        assert_eq!(rows.len(), 6);
     }
 }

@@ -12,6 +12,8 @@ pub trait Progress {
     fn note(&mut self, _text: &str) {}
     /// The work is over: clear whatever is drawn.
     fn finish(&mut self) {}
+    /// The work failed: stop drawing without saying the step was done.
+    fn abandon(&mut self) {}
 }
 
 /// Reports nothing (tests, library callers that do not draw).
