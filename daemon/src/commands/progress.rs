@@ -7,7 +7,7 @@
 use std::io::{IsTerminal, Write};
 use std::time::{Duration, Instant};
 
-use indicatif::{HumanCount, ProgressBar, ProgressStyle};
+use indicatif::{HumanCount, ProgressBar, ProgressState, ProgressStyle};
 
 use crate::offline::progress::Progress;
 
@@ -47,12 +47,16 @@ impl Progress for Bar {
         }
         let template = match total {
             Some(_) => format!(
-                "{{prefix}} {{wide_bar}} {{human_pos}}/{{human_len}} {unit} {{per_sec}} ETA {{eta}} {{msg}}"
+                "{{prefix}} {{wide_bar}} {{human_pos}}/{{human_len}} {unit} {{rate}} ETA {{eta}} {{msg}}"
             ),
-            None => format!("{{prefix}} {{spinner}} {{human_pos}} {unit} {{per_sec}} {{msg}}"),
+            None => format!("{{prefix}} {{spinner}} {{human_pos}} {unit} {{rate}} {{msg}}"),
         };
         let style = ProgressStyle::with_template(&template)
             .expect("the templates above are valid")
+            .with_key("rate", |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+                // Whole units per second: indicatif's own key prints four decimals.
+                let _ = write!(w, "{}/s", HumanCount(state.per_sec() as u64));
+            })
             .progress_chars("=> ");
         let bar = match total {
             Some(n) => ProgressBar::new(n),
