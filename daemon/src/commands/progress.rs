@@ -53,10 +53,13 @@ impl Progress for Bar {
         };
         let style = ProgressStyle::with_template(&template)
             .expect("the templates above are valid")
-            .with_key("rate", |state: &ProgressState, w: &mut dyn std::fmt::Write| {
-                // Whole units per second: indicatif's own key prints four decimals.
-                let _ = write!(w, "{}/s", HumanCount(state.per_sec() as u64));
-            })
+            .with_key(
+                "rate",
+                |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+                    // Whole units per second: indicatif's own key prints four decimals.
+                    let _ = write!(w, "{}/s", HumanCount(state.per_sec() as u64));
+                },
+            )
             .progress_chars("=> ");
         let bar = match total {
             Some(n) => ProgressBar::new(n),
