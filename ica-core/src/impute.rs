@@ -15,11 +15,16 @@
 //!
 //! Frames missing more than [`MAX_MISSING_SHARE`] of their channels are not filled and stay
 //! out of training.
+//!
+//! For sessions too long to hold, the same rounds run over a stream: [`frame_gaps`] sorts
+//! each frame, [`GapModel::from_whitener`] reads the PCA of streamed moments
+//! ([`crate::whiten::Moments`], [`crate::whiten::Moments::merge_filled`]) as the model that
+//! fills, one pass over the gappy frames per round.
 
 use nalgebra::{DMatrix, DVector};
 
 use crate::input::{FitData, FitError};
-use crate::whiten::{self, Components};
+use crate::whiten::{self, Components, Whitener};
 
 /// Rounds of PCA and filling.
 pub const EM_ITERATIONS: usize = 3;
@@ -37,6 +42,29 @@ pub struct GapFill {
     pub frames_left_out: usize,
 }
 
+/// What a frame's gaps make of it in training.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameGaps {
+    /// Nothing missing.
+    Complete,
+    /// Some channels missing: filled.
+    Fill,
+    /// More than [`MAX_MISSING_SHARE`] of the channels missing: left out.
+    LeaveOut,
+}
+
+/// How [`fill_gaps`] treats a frame with these missing flags.
+pub fn frame_gaps(missing: &[bool]) -> FrameGaps {
+    let gone = missing.iter().filter(|&&m| m).count();
+    if gone == 0 {
+        FrameGaps::Complete
+    } else if gone as f64 > MAX_MISSING_SHARE * missing.len() as f64 {
+        FrameGaps::LeaveOut
+    } else {
+        FrameGaps::Fill
+    }
+}
+
 /// Fills the gaps of `samples` (frames x channels) in place; returns the mask of what is still
 /// missing afterwards (only frames with too many gaps) and what was done. See the module docs.
 ///
@@ -50,18 +78,15 @@ pub fn fill_gaps(
     components: Components,
 ) -> Result<(Vec<bool>, GapFill), FitError> {
     let frames = missing.len() / channels.max(1);
-    let gappy = |f: usize| missing[f * channels..(f + 1) * channels].iter().any(|&m| m);
-    let too_many = |f: usize| {
-        let gone = missing[f * channels..(f + 1) * channels]
-            .iter()
-            .filter(|&&m| m)
-            .count();
-        gone as f64 > MAX_MISSING_SHARE * channels as f64
-    };
-    let fillable: Vec<usize> = (0..frames).filter(|&f| gappy(f) && !too_many(f)).collect();
+    let gaps = |f: usize| frame_gaps(&missing[f * channels..(f + 1) * channels]);
+    let fillable: Vec<usize> = (0..frames)
+        .filter(|&f| gaps(f) == FrameGaps::Fill)
+        .collect();
     let mut after: Vec<bool> = missing.to_vec();
     let mut report = GapFill {
-        frames_left_out: (0..frames).filter(|&f| too_many(f)).count(),
+        frames_left_out: (0..frames)
+            .filter(|&f| gaps(f) == FrameGaps::LeaveOut)
+            .count(),
         ..GapFill::default()
     };
     if fillable.is_empty() {
@@ -77,7 +102,7 @@ pub fn fill_gaps(
         let mask: &[bool] = if iteration == 0 { missing } else { &after };
         let data = FitData::new(&*samples, channels)?.with_missing(mask)?;
         let pca = whiten::whiten(&data, components)?;
-        let model = Ppca::new(&pca, channels);
+        let model = GapModel::new(&pca, channels);
         for &f in &fillable {
             let frame = &mut samples[f * channels..(f + 1) * channels];
             model.fill(frame, &missing[f * channels..(f + 1) * channels]);
@@ -102,8 +127,10 @@ pub fn fill_gaps(
     Ok((after, report))
 }
 
-/// A PCA read as a probabilistic PCA, over all channels (dead ones have zero loadings).
-struct Ppca {
+/// A PCA read as a probabilistic PCA, over all channels (dead ones have zero loadings): the
+/// model one round of [`fill_gaps`] fills with.
+#[derive(Debug, Clone)]
+pub struct GapModel {
     mean: Vec<f64>,
     /// `A = E Λ^½`, channels x m.
     loadings: DMatrix<f64>,
@@ -111,25 +138,53 @@ struct Ppca {
     residual: f64,
 }
 
-impl Ppca {
-    fn new(w: &whiten::Whitening, channels: usize) -> Ppca {
-        let m = w.components();
+impl GapModel {
+    fn new(w: &whiten::Whitening, channels: usize) -> GapModel {
+        Self::from_parts(
+            &w.mean,
+            &w.live_channels,
+            &w.basis,
+            &w.eigenvalues,
+            channels,
+        )
+    }
+
+    /// The model of a fitted whitening (a streamed PCA), as [`fill_gaps`] builds it from an
+    /// in-memory one.
+    pub fn from_whitener(w: &Whitener) -> GapModel {
+        Self::from_parts(
+            &w.mean,
+            &w.live_channels,
+            &w.basis,
+            &w.eigenvalues,
+            w.channels(),
+        )
+    }
+
+    fn from_parts(
+        mean: &[f64],
+        live: &[usize],
+        basis: &DMatrix<f64>,
+        eigenvalues: &[f64],
+        channels: usize,
+    ) -> GapModel {
+        let m = basis.ncols();
         let mut loadings = DMatrix::zeros(channels, m);
-        for (r, &c) in w.live_channels.iter().enumerate() {
+        for (r, &c) in live.iter().enumerate() {
             for k in 0..m {
-                loadings[(c, k)] = w.basis[(r, k)] * w.eigenvalues[k].sqrt();
+                loadings[(c, k)] = basis[(r, k)] * eigenvalues[k].sqrt();
             }
         }
-        let left: f64 = w.eigenvalues.iter().skip(m).sum();
-        Ppca {
-            mean: w.mean.clone(),
+        let left: f64 = eigenvalues.iter().skip(m).sum();
+        GapModel {
+            mean: mean.to_vec(),
             loadings,
-            residual: left / w.live_channels.len().max(1) as f64,
+            residual: left / live.len().max(1) as f64,
         }
     }
 
-    /// Fills the `missing` channels of `frame` with their posterior mean.
-    fn fill(&self, frame: &mut [f32], missing: &[bool]) {
+    /// Fills the `missing` channels of `frame` with their posterior mean given the others.
+    pub fn fill(&self, frame: &mut [f32], missing: &[bool]) {
         let m = self.loadings.ncols();
         let mut gram = DMatrix::<f64>::identity(m, m) * self.residual.max(1e-12);
         let mut rhs = DVector::<f64>::zeros(m);

@@ -35,41 +35,71 @@ impl TrainingFrames<'_> {
             .any(|&m| m)
     }
 
-    /// The residual `(x − mean) − M W (x − mean)` of a complete frame, into `out`.
-    fn residual_into(
-        &self,
-        model: &IcaModel,
-        f: usize,
-        centred: &mut DVector<f64>,
-        u: &mut DVector<f64>,
-        out: &mut DVector<f64>,
-    ) {
-        let c = self.channels;
-        for (k, v) in centred.iter_mut().enumerate() {
-            *v = f64::from(self.samples[f * c + k]) - model.mean()[k];
+    fn frame(&self, f: usize) -> &[f32] {
+        &self.samples[f * self.channels..(f + 1) * self.channels]
+    }
+}
+
+/// Working vectors of [`residual_into`].
+struct Residual {
+    centred: DVector<f64>,
+    u: DVector<f64>,
+    r: DVector<f64>,
+}
+
+impl Residual {
+    fn new(model: &IcaModel) -> Self {
+        let c = model.channels();
+        Self {
+            centred: DVector::zeros(c),
+            u: DVector::zeros(model.components()),
+            r: DVector::zeros(c),
         }
-        u.gemv(1.0, model.unmixing(), centred, 0.0);
-        out.copy_from(centred);
-        out.gemv(-1.0, model.mixing(), u, 1.0);
+    }
+
+    /// The residual `(x − mean) − M W (x − mean)` of `x` (a complete frame, or a mean of
+    /// complete frames: the residual is linear in `x`), into `self.r`.
+    fn of(&mut self, model: &IcaModel, x: impl Iterator<Item = f64>) -> &DVector<f64> {
+        for ((v, x), mu) in self.centred.iter_mut().zip(x).zip(model.mean()) {
+            *v = x - mu;
+        }
+        self.u.gemv(1.0, model.unmixing(), &self.centred, 0.0);
+        self.r.copy_from(&self.centred);
+        self.r.gemv(-1.0, model.mixing(), &self.u, 1.0);
+        &self.r
     }
 }
 
 /// Frames examined at most by [`residual_by_marker`] (evenly strided).
 pub const MAX_RESIDUAL_FRAMES: usize = 20_000;
 
-/// Reconstruction residual per marker (mm RMS of the 3-D error) over complete training frames.
+/// The stride [`residual_by_marker`] reads frames at, for a session of `frames` frames.
+pub fn residual_stride(frames: usize) -> usize {
+    (frames / MAX_RESIDUAL_FRAMES).max(1)
+}
+
+/// Reconstruction residual per marker (mm RMS of the 3-D error) over complete training frames
+/// (every [`residual_stride`]-th frame).
 pub fn residual_by_marker(model: &IcaModel, data: &TrainingFrames<'_>) -> Vec<f64> {
-    let c = data.channels;
-    let (m, markers) = (model.components(), c / 3);
-    let stride = (data.frames() / MAX_RESIDUAL_FRAMES).max(1);
-    let (mut centred, mut u, mut r) = (DVector::zeros(c), DVector::zeros(m), DVector::zeros(c));
-    let mut sq = vec![0.0; markers];
+    let stride = residual_stride(data.frames());
+    let frames = (0..data.frames())
+        .step_by(stride)
+        .filter(|&f| data.complete(f))
+        .map(|f| data.frame(f));
+    residual_by_marker_of(model, frames)
+}
+
+/// [`residual_by_marker`] over the complete frames given (`channels` values each), as a
+/// streaming caller collects them.
+pub fn residual_by_marker_of<'a>(
+    model: &IcaModel,
+    frames: impl Iterator<Item = &'a [f32]>,
+) -> Vec<f64> {
+    let mut res = Residual::new(model);
+    let mut sq = vec![0.0; model.markers()];
     let mut count = 0usize;
-    for f in (0..data.frames()).step_by(stride) {
-        if !data.complete(f) {
-            continue;
-        }
-        data.residual_into(model, f, &mut centred, &mut u, &mut r);
+    for x in frames {
+        let r = res.of(model, x.iter().map(|&v| f64::from(v)));
         for (k, s) in sq.iter_mut().enumerate() {
             *s += r[3 * k].powi(2) + r[3 * k + 1].powi(2) + r[3 * k + 2].powi(2);
         }
@@ -83,17 +113,26 @@ pub fn residual_by_marker(model: &IcaModel, data: &TrainingFrames<'_>) -> Vec<f6
 /// Window of the slow residual's low pass (seconds): expressions and moods, not speech.
 pub const SLOW_WINDOW_S: f64 = 0.5;
 
+/// Frames per block of the slow residual at `rate_hz`.
+pub fn slow_block_frames(rate_hz: f64) -> usize {
+    ((SLOW_WINDOW_S * rate_hz).round() as usize).max(2)
+}
+
+/// Of a take's complete blocks, every this-many-th is kept (about 4000 blocks in all).
+pub fn slow_block_stride(frames: usize, block: usize) -> usize {
+    (frames / block / 4000).max(1)
+}
+
 /// The strongest slow signal the model leaves out: the residual is averaged over blocks of
 /// [`SLOW_WINDOW_S`] within each take (a low pass that also divides white noise by the block
 /// length), and its leading direction is found by power iteration. Returns that direction's
 /// RMS at its peak marker (mm) and the marker, or `None` with fewer than 8 blocks.
 pub fn slow_residual(model: &IcaModel, data: &TrainingFrames<'_>) -> Option<(f64, usize)> {
     let c = data.channels;
-    let m = model.components();
-    let block = ((SLOW_WINDOW_S * data.rate_hz).round() as usize).max(2);
-    let (mut centred, mut u, mut r) = (DVector::zeros(c), DVector::zeros(m), DVector::zeros(c));
+    let block = slow_block_frames(data.rate_hz);
+    let mut res = Residual::new(model);
     let mut blocks: Vec<DVector<f64>> = Vec::new();
-    let stride_blocks = (data.frames() / block / 4000).max(1);
+    let stride_blocks = slow_block_stride(data.frames(), block);
     for take in data.takes {
         let mut acc = DVector::zeros(c);
         let mut filled = 0usize;
@@ -104,8 +143,7 @@ pub fn slow_residual(model: &IcaModel, data: &TrainingFrames<'_>) -> Option<(f64
                 filled = 0;
                 continue;
             }
-            data.residual_into(model, f, &mut centred, &mut u, &mut r);
-            acc += &r;
+            acc += res.of(model, data.frame(f).iter().map(|&v| f64::from(v)));
             filled += 1;
             if filled == block {
                 if index % stride_blocks == 0 {
@@ -117,6 +155,23 @@ pub fn slow_residual(model: &IcaModel, data: &TrainingFrames<'_>) -> Option<(f64
             }
         }
     }
+    slow_direction(blocks, c)
+}
+
+/// [`slow_residual`] from the kept blocks' mean frames (the residual is linear, so the
+/// residual of a block's mean is the block's mean residual), as a streaming caller collects
+/// them.
+pub fn slow_residual_of_means(model: &IcaModel, means: &[Vec<f64>]) -> Option<(f64, usize)> {
+    let mut res = Residual::new(model);
+    let blocks = means
+        .iter()
+        .map(|x| res.of(model, x.iter().copied()).clone())
+        .collect();
+    slow_direction(blocks, model.channels())
+}
+
+/// The leading direction of the block residuals at its peak marker.
+fn slow_direction(blocks: Vec<DVector<f64>>, c: usize) -> Option<(f64, usize)> {
     if blocks.len() < 8 {
         return None;
     }
@@ -176,17 +231,21 @@ pub fn one_marker_components(model: &IcaModel, share: f64) -> Vec<(usize, usize,
         .collect()
 }
 
+/// The stride [`noise_per_coordinate`] reads second differences at, for `frames` frames.
+pub fn noise_stride(frames: usize) -> usize {
+    (frames / 5000).max(1)
+}
+
 /// The capture's noise per coordinate (mm): the median over channels of the robust spread of
-/// second differences within takes, divided by √6.
+/// second differences within takes (every [`noise_stride`]-th frame of each take, from its
+/// second), divided by √6.
 pub fn noise_per_coordinate(data: &TrainingFrames<'_>) -> f64 {
     let c = data.channels;
-    let mut per_channel = Vec::with_capacity(c);
-    let mut d2 = Vec::new();
-    let stride = (data.frames() / 5000).max(1);
-    for ch in 0..c {
-        d2.clear();
-        for take in data.takes {
-            for f in (take.start + 1..take.end.saturating_sub(1)).step_by(stride) {
+    let mut per_channel = vec![Vec::new(); c];
+    let stride = noise_stride(data.frames());
+    for take in data.takes {
+        for f in (take.start + 1..take.end.saturating_sub(1)).step_by(stride) {
+            for (ch, d2) in per_channel.iter_mut().enumerate() {
                 let at = |g: usize| {
                     (!data.missing[g * c + ch]).then(|| f64::from(data.samples[g * c + ch]))
                 };
@@ -195,9 +254,17 @@ pub fn noise_per_coordinate(data: &TrainingFrames<'_>) -> f64 {
                 }
             }
         }
-        if d2.len() >= 10 {
-            per_channel.push(mad(&mut d2) / 6f64.sqrt());
-        }
     }
-    median(&mut per_channel)
+    noise_of_differences(&mut per_channel)
+}
+
+/// [`noise_per_coordinate`] from the second differences of each channel, as a streaming
+/// caller collects them.
+pub fn noise_of_differences(per_channel: &mut [Vec<f64>]) -> f64 {
+    let mut spread: Vec<f64> = per_channel
+        .iter_mut()
+        .filter(|d2| d2.len() >= 10)
+        .map(|d2| mad(d2) / 6f64.sqrt())
+        .collect();
+    median(&mut spread)
 }

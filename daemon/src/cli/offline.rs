@@ -136,6 +136,14 @@ pub struct TrainArgs {
     /// Do not learn per-marker plausible regions (which drop swapped or drifting labels).
     #[arg(long)]
     pub no_bounds: bool,
+    /// Threads for the passes over the takes (0: one per core; 1 stays on one core). The model
+    /// is the same whatever the count.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Stream the takes even when the session is short enough to train in memory (sessions
+    /// longer than 50,000 frames always stream, in bounded memory).
+    #[arg(long)]
+    pub stream: bool,
     /// Overwrite the output if it exists.
     #[arg(long)]
     pub force: bool,

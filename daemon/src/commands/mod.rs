@@ -7,6 +7,7 @@ mod demo;
 mod edit;
 mod info;
 mod inspect;
+pub mod progress;
 mod project;
 mod replay;
 mod serve;

@@ -1,6 +1,6 @@
 //! `emoshift train`: learn an ICA model from takes.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -12,7 +12,8 @@ use indicatif::ProgressBar;
 use crate::cli::TrainArgs;
 use crate::exit::UsageError;
 use crate::offline::training::{
-    self, HeadChoice, PrepOptions, PreparedData, SpeedLimit, Stage, TrainOptions, Trained,
+    self, HeadChoice, PrepOptions, PrepReport, SpeedLimit, Stage, StreamOptions, TrainOptions,
+    Trained,
 };
 use crate::offline::{self, LoadedTake};
 use replay::session::Regions;
@@ -120,15 +121,31 @@ pub(crate) fn options_with_regions(regions: Regions) -> TrainOptions {
 
 pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     let options = options(args)?;
-    let takes = offline::load_inputs(args.manifest.as_deref(), &args.files)?;
-    let mut inputs: Vec<&Path> = takes.iter().map(|t| t.path.as_path()).collect();
+    let paths = offline::input_paths(args.manifest.as_deref(), &args.files)?;
+    let mut inputs: Vec<&Path> = paths.iter().map(PathBuf::as_path).collect();
     inputs.extend(args.manifest.as_deref());
     offline::output::check_out(&args.out, &inputs, args.force)?;
-    train_and_save(&takes, &options, &args.out).map(drop)
+    let stream = StreamOptions {
+        threads: args.threads,
+        always_stream: args.stream,
+    };
+    let started = Instant::now();
+    let mut progress = super::progress::for_stderr("train");
+    let trained = training::train_files(&paths, &options, &stream, progress.as_mut());
+    match trained {
+        Ok(trained) => {
+            progress.finish();
+            save_and_print(trained, paths.len(), &args.out, started).map(drop)
+        }
+        Err(e) => {
+            progress.abandon();
+            Err(e)
+        }
+    }
 }
 
-/// Trains on `takes`, writes the model to `out` and prints what training found, as `train`
-/// does; returns the model.
+/// Trains on `takes` held in memory, writes the model to `out` and prints what training
+/// found, as `train` does; returns the model.
 pub(crate) fn train_and_save(
     takes: &[LoadedTake],
     options: &TrainOptions,
@@ -144,6 +161,16 @@ pub(crate) fn train_and_save(
         }
     })?;
     bar.finish_and_clear();
+    save_and_print(trained, takes.len(), out, started)
+}
+
+/// Writes the model to `out` and prints what training found.
+fn save_and_print(
+    trained: Trained,
+    takes: usize,
+    out: &Path,
+    started: Instant,
+) -> Result<IcaModel> {
     let Trained {
         model,
         data,
@@ -165,7 +192,7 @@ pub(crate) fn train_and_save(
             gaps.frames_left_out
         );
     }
-    print_summary(&model, takes.len(), started.elapsed().as_secs_f64())?;
+    print_summary(&model, takes, started.elapsed().as_secs_f64())?;
     if capped_at_noise {
         crate::out!(
             "the default {:.0} % of the variance would reach into noise ({noise_mm:.3} mm per coordinate): kept the {} components above the noise floor",
@@ -178,7 +205,7 @@ pub(crate) fn train_and_save(
     Ok(model)
 }
 
-fn print_preparation(data: &PreparedData) -> Result<()> {
+fn print_preparation(data: &PrepReport) -> Result<()> {
     for (file, from, to) in &data.resampled {
         crate::out!("resampled {file} from {from} Hz to {to} Hz");
     }
@@ -224,7 +251,7 @@ fn print_preparation(data: &PreparedData) -> Result<()> {
         data.head.source,
         data.head.verdict
     );
-    if let Some((median, p95)) = data.residual_summary() {
+    if let Some((median, p95)) = data.residual_summary {
         crate::out!(
             "head stabilised on {}: residual median {median:.2} mm, p95 {p95:.2} mm",
             data.reference.join(", ")

@@ -1,15 +1,18 @@
 //! Offline work over takes and models, as library functions the commands and the demo call:
 //! loading and projecting takes ([`takes`]), preparing captures for training and the model's
-//! quality report ([`training`]), the analysis of a paired session ([`analysis`]), and edit
+//! quality report ([`training`], streaming long sessions), progress reports ([`progress`]), the
+//! analysis of a paired session ([`analysis`]), and edit
 //! planning ([`edit`]).
 
 pub mod analysis;
 pub mod edit;
 pub mod output;
+pub mod progress;
 pub mod takes;
 pub mod training;
 
 pub use takes::{
-    load_inputs, load_model, load_model_limited, load_session, load_take, match_take, project_take,
-    resynthesise, set_input_limit, to_model_order, LoadedTake, ModelFrames, Projected,
+    input_paths, load_inputs, load_model, load_model_limited, load_session, load_take, match_take,
+    project_take, resynthesise, set_input_limit, to_model_order, LoadedTake, ModelFrames,
+    Projected,
 };

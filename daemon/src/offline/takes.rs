@@ -1,6 +1,7 @@
 //! Offline glue between takes and models: loading the inputs of a command, putting takes in a
 //! model's marker order, projecting and resynthesising whole takes.
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -75,11 +76,12 @@ pub fn load_session(path: &Path) -> Result<Session> {
     Ok(Session::load(path)?)
 }
 
-/// The input takes of a command: the manifest's takes, or the files given.
+/// The input files of a command, without reading them: the files given, then the manifest's
+/// takes.
 ///
 /// # Errors
-/// No input, or any take that cannot be loaded.
-pub fn load_inputs(manifest: Option<&Path>, files: &[PathBuf]) -> Result<Vec<LoadedTake>> {
+/// No input, or a manifest that cannot be read.
+pub fn input_paths(manifest: Option<&Path>, files: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let mut paths: Vec<PathBuf> = files.to_vec();
     if let Some(manifest) = manifest {
         paths.extend(load_session(manifest)?.take_paths());
@@ -87,7 +89,15 @@ pub fn load_inputs(manifest: Option<&Path>, files: &[PathBuf]) -> Result<Vec<Loa
     if paths.is_empty() {
         bail!("no takes given: pass --manifest session.toml or take files");
     }
-    paths
+    Ok(paths)
+}
+
+/// The input takes of a command: the manifest's takes, or the files given.
+///
+/// # Errors
+/// No input, or any take that cannot be loaded.
+pub fn load_inputs(manifest: Option<&Path>, files: &[PathBuf]) -> Result<Vec<LoadedTake>> {
+    input_paths(manifest, files)?
         .into_iter()
         .map(|path| {
             let take = load_take(&path)?;
@@ -125,16 +135,21 @@ impl ModelFrames {
 
 /// Gathers a whole take into model order.
 pub fn to_model_order(take: &Take, map: &LabelMap) -> ModelFrames {
+    frames_in_model_order(take, map, 0..take.n_frames())
+}
+
+/// Gathers frames `range` of a take into model order.
+pub fn frames_in_model_order(take: &Take, map: &LabelMap, range: Range<usize>) -> ModelFrames {
     let markers = map.model_to_take.len();
-    let frames = take.n_frames();
+    let frames = range.len();
     let mut xyz = vec![0.0; frames * markers * 3];
     let mut missing = vec![true; frames * markers];
-    for f in 0..frames {
+    for (k, f) in range.enumerate() {
         map.gather_into(
             take.frame(f),
             take.frame_missing(f),
-            &mut xyz[f * markers * 3..(f + 1) * markers * 3],
-            &mut missing[f * markers..(f + 1) * markers],
+            &mut xyz[k * markers * 3..(k + 1) * markers * 3],
+            &mut missing[k * markers..(k + 1) * markers],
         );
     }
     ModelFrames {

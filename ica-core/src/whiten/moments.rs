@@ -268,6 +268,20 @@ impl Moments {
         Ok(())
     }
 
+    /// Adds `filled`'s used frames without counting its frames as offered: they are frames this
+    /// accumulator was already offered with gaps (and so did not use), now with the gaps
+    /// filled ([`crate::impute::GapModel`]). The result is the moments of the session with its
+    /// gaps filled, as [`super::whiten`] sees it after [`crate::impute::fill_gaps`].
+    ///
+    /// # Errors
+    /// As [`Moments::merge`].
+    pub fn merge_filled(&mut self, filled: Moments) -> Result<(), FitError> {
+        let offered = self.frames_total;
+        self.merge(filled)?;
+        self.frames_total = offered;
+        Ok(())
+    }
+
     /// Checks every present sample is finite and records, in `chunk_missing`, the channels
     /// missing in every frame of the chunk.
     fn scan<T: Copy + Into<f64>>(&mut self, chunk: &FitData<'_, T>) -> Result<(), FitError> {

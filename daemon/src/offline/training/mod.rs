@@ -16,10 +16,12 @@
 //! The same [`FramePrep`] then runs in `project`, `edit` and the daemon, from the settings
 //! stored in the model.
 
+mod capture;
 mod glitches;
 pub mod head;
 mod model;
 pub mod quality;
+mod stream;
 
 use std::ops::Range;
 
@@ -27,12 +29,13 @@ use anyhow::{bail, Result};
 use ica_core::model::CaptureSettings;
 use ica_core::quality::HeadReport;
 use ica_core::robust::quantile;
-use ica_core::stabilise::{MarkerFrames, Stabiliser};
 
-use glitches::{auto_speed, glitches_per_marker, marker_bounds};
+use capture::RefResiduals;
+use glitches::glitches_per_marker;
 pub use glitches::{AUTO_SPEED_FACTOR, BOUNDS_FACTOR, MIN_AUTO_SPEED_MM_S, MIN_BOUNDS_MM};
 pub use head::{HeadChoice, DEFAULT_HEAD_PATTERNS};
-pub use model::{train, Stage, TrainOptions, Trained};
+pub use model::{train, PrepReport, Stage, TrainOptions, Trained};
+pub use stream::{train_files, StreamOptions, IN_MEMORY_FRAMES, SAMPLE_FRAMES};
 
 use crate::engine::frame::FramePrep;
 use crate::engine::layout::LabelMap;
@@ -119,17 +122,21 @@ pub struct PreparedData {
 impl PreparedData {
     /// Median and 95th percentile of the stabilisation residual (mm).
     pub fn residual_summary(&self) -> Option<(f64, f64)> {
-        let mut r: Vec<f64> = self
-            .residuals_mm
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .collect();
-        if r.is_empty() {
-            return None;
-        }
-        Some((quantile(&mut r, 0.5), quantile(&mut r, 0.95)))
+        residual_summary(&self.residuals_mm)
     }
+}
+
+/// Median and 95th percentile of the finite stabilisation residuals (mm).
+pub(crate) fn residual_summary(residuals_mm: &[f64]) -> Option<(f64, f64)> {
+    let mut r: Vec<f64> = residuals_mm
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    if r.is_empty() {
+        return None;
+    }
+    Some((quantile(&mut r, 0.5), quantile(&mut r, 0.95)))
 }
 
 /// Prepares loaded takes for training. See the module docs.
@@ -162,59 +169,26 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         })
         .collect::<Result<_>>()?;
     let n = labels.len();
-    // 1. The head: decided on the raw frames, template from them (its Procrustes mean shrugs
-    //    off rare glitches).
-    let raw_missing: Vec<bool> = frames
-        .iter()
-        .flat_map(|f| f.missing.iter().copied())
-        .collect();
-    let raw_xyz: Vec<f32> = frames.iter().flat_map(|f| f.xyz.iter().copied()).collect();
     let mut ranges = Vec::with_capacity(frames.len());
     let mut start = 0;
     for f in &frames {
         ranges.push(start..start + f.frames());
         start += f.frames();
     }
-    let raw = MarkerFrames {
-        xyz: &raw_xyz,
-        missing: &raw_missing,
-        markers: n,
-        takes: &ranges,
-    };
-    let decision = head::decide(&options.head, &labels, &raw)?;
-    let reference = decision.markers;
-    let mut head_report = decision.report;
-    let head = match reference.len() {
-        0 => None,
-        _ => Some(
-            Stabiliser::fit(&raw_xyz, &raw_missing, n, reference.clone())?
-                .reference()
-                .clone(),
-        ),
-    };
-    let mut capture = CaptureSettings {
-        head,
-        max_speed_mm_s: None,
-        bounds: None,
-    };
-    // 2. Speeds and plausible regions measured in head coordinates, then applied.
-    let (head_xyz, head_missing, _, _) = run_prep(&frames, n, rate_hz, &capture)?;
-    capture.max_speed_mm_s = match options.speed {
-        SpeedLimit::Off => None,
-        SpeedLimit::MmPerS(v) => Some(v),
-        SpeedLimit::Auto => auto_speed(&head_xyz, &head_missing, &frames, n, rate_hz),
-    };
-    if options.bounds {
-        capture.bounds = Some(marker_bounds(&head_xyz, &head_missing, n));
-    }
+    let learned = capture::learn(&frames, &labels, rate_hz, options)?;
+    let (capture, reference, mut head_report) = (learned.capture, learned.reference, learned.head);
     let (samples, marker_missing, glitches, residuals_mm) =
         run_prep(&frames, n, rate_hz, &capture)?;
     let per_marker = glitches_per_marker(&frames, &marker_missing, n);
     if let Some(h) = &capture.head {
-        head_report.residual_mm = reference_residuals(h, &samples, &marker_missing, n)
-            .into_iter()
-            .map(|(m, r)| (labels[m].clone(), r))
-            .collect();
+        let mut sums = RefResiduals::new(h);
+        for (xyz, missing) in samples
+            .chunks_exact(n * 3)
+            .zip(marker_missing.chunks_exact(n))
+        {
+            sums.add_frame(xyz, missing);
+        }
+        head_report.residual_mm = sums.by_label(&labels);
     }
     Ok(PreparedData {
         head: head_report,
@@ -233,11 +207,11 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
     })
 }
 
-type PrepRun = (Vec<f32>, Vec<bool>, usize, Vec<f64>);
+pub(crate) type PrepRun = (Vec<f32>, Vec<bool>, usize, Vec<f64>);
 
 /// Runs every take through a fresh [`FramePrep`]: positions, per-marker mask, glitches,
 /// residuals.
-fn run_prep(
+pub(crate) fn run_prep(
     frames: &[ModelFrames],
     n: usize,
     rate_hz: f64,
@@ -269,78 +243,69 @@ type KeptMarkers = (Vec<String>, Vec<(String, f64)>);
 
 /// The first take's labels minus the markers missing too often over all takes.
 fn kept_markers(takes: &[replay::Take], max_share: f64) -> Result<KeptMarkers> {
-    let first = &takes[0].labels;
-    let mut missing = vec![0usize; first.len()];
-    let mut frames = 0usize;
+    let mut counts = MissingCounts::new(takes[0].labels.clone());
     for t in takes {
-        let map = LabelMap::new(first, &t.labels)?;
+        counts.add(t)?;
+    }
+    counts.kept(max_share)
+}
+
+/// How often each of the first take's markers is missing, over takes added one at a time.
+#[derive(Debug, Clone)]
+pub(crate) struct MissingCounts {
+    first: Vec<String>,
+    missing: Vec<usize>,
+    frames: usize,
+}
+
+impl MissingCounts {
+    pub(crate) fn new(first: Vec<String>) -> Self {
+        let missing = vec![0; first.len()];
+        Self {
+            first,
+            missing,
+            frames: 0,
+        }
+    }
+
+    /// Counts a take (at the model rate).
+    ///
+    /// # Errors
+    /// The take shares no marker with the first.
+    pub(crate) fn add(&mut self, t: &replay::Take) -> Result<()> {
+        let map = LabelMap::new(&self.first, &t.labels)?;
         let counts = t.missing_per_marker();
         for (i, src) in map.model_to_take.iter().enumerate() {
-            missing[i] += match src {
+            self.missing[i] += match src {
                 Some(j) => counts[*j],
                 None => t.n_frames(),
             };
         }
-        frames += t.n_frames();
+        self.frames += t.n_frames();
+        Ok(())
     }
-    let mut kept = Vec::new();
-    let mut excluded = Vec::new();
-    for (label, &gone) in first.iter().zip(&missing) {
-        let share = gone as f64 / frames.max(1) as f64;
-        if share > max_share {
-            excluded.push((label.clone(), share));
-        } else {
-            kept.push(label.clone());
-        }
-    }
-    if kept.is_empty() {
-        bail!(
-            "every marker is missing in more than {:.0} % of the frames",
-            100.0 * max_share
-        );
-    }
-    Ok((kept, excluded))
-}
 
-/// RMS distance (mm) of each reference marker from its template place, over the prepared
-/// (head-coordinate) frames: how rigid the reference held.
-fn reference_residuals(
-    head: &ica_core::stabilise::HeadReference,
-    xyz: &[f32],
-    missing: &[bool],
-    n: usize,
-) -> Vec<(usize, f64)> {
-    let frames = missing.len() / n.max(1);
-    // Head coordinates put the template's centroid where the Procrustes fit put it: compare
-    // each frame's reference shape, centred, to the centred template.
-    let mut sq = vec![0.0f64; head.markers.len()];
-    let mut count = vec![0usize; head.markers.len()];
-    for f in 0..frames {
-        let present: Vec<usize> = (0..head.markers.len())
-            .filter(|&k| !missing[f * n + head.markers[k]])
-            .collect();
-        if present.len() < 3 {
-            continue;
-        }
-        let at = |k: usize, a: usize| f64::from(xyz[(f * n + head.markers[k]) * 3 + a]);
-        let mut c = [0.0; 3];
-        let mut t = [0.0; 3];
-        for &k in &present {
-            for a in 0..3 {
-                c[a] += at(k, a) / present.len() as f64;
-                t[a] += head.template[k][a] / present.len() as f64;
+    /// The markers kept and those left out (see [`PrepOptions::max_missing_share`]).
+    ///
+    /// # Errors
+    /// Every marker is missing too often.
+    pub(crate) fn kept(&self, max_share: f64) -> Result<KeptMarkers> {
+        let mut kept = Vec::new();
+        let mut excluded = Vec::new();
+        for (label, &gone) in self.first.iter().zip(&self.missing) {
+            let share = gone as f64 / self.frames.max(1) as f64;
+            if share > max_share {
+                excluded.push((label.clone(), share));
+            } else {
+                kept.push(label.clone());
             }
         }
-        for &k in &present {
-            sq[k] += (0..3)
-                .map(|a| (at(k, a) - c[a] - (head.template[k][a] - t[a])).powi(2))
-                .sum::<f64>();
-            count[k] += 1;
+        if kept.is_empty() {
+            bail!(
+                "every marker is missing in more than {:.0} % of the frames",
+                100.0 * max_share
+            );
         }
+        Ok((kept, excluded))
     }
-    head.markers
-        .iter()
-        .enumerate()
-        .map(|(k, &m)| (m, (sq[k] / count[k].max(1) as f64).sqrt()))
-        .collect()
 }

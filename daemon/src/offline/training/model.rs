@@ -51,13 +51,57 @@ pub enum Stage {
     },
 }
 
+/// What preparing the captures found, for the report `train` prints (the prepared frames
+/// themselves are not kept: streaming training never holds them).
+#[derive(Debug, Clone)]
+pub struct PrepReport {
+    /// Marker labels of the model.
+    pub labels: Vec<String>,
+    /// Model rate.
+    pub rate_hz: f64,
+    /// Settings stored in the model.
+    pub capture: ica_core::model::CaptureSettings,
+    /// Markers left out, with the share of frames they were missing in.
+    pub excluded: Vec<(String, f64)>,
+    /// Takes resampled: file, from rate, to rate.
+    pub resampled: Vec<(String, f64, f64)>,
+    /// Samples dropped as glitches.
+    pub glitches: usize,
+    /// Glitches per marker (model order).
+    pub glitches_per_marker: Vec<usize>,
+    /// Median and 95th percentile of the stabilisation residual (mm), when stabilised.
+    pub residual_summary: Option<(f64, f64)>,
+    /// Reference marker labels (empty without stabilisation).
+    pub reference: Vec<String>,
+    /// How the head reference was decided, with its numbers.
+    pub head: ica_core::quality::HeadReport,
+}
+
+impl PrepReport {
+    /// The report of data prepared in memory.
+    pub fn of(data: &PreparedData) -> Self {
+        Self {
+            labels: data.labels.clone(),
+            rate_hz: data.rate_hz,
+            capture: data.capture.clone(),
+            excluded: data.excluded.clone(),
+            resampled: data.resampled.clone(),
+            glitches: data.glitches,
+            glitches_per_marker: data.glitches_per_marker.clone(),
+            residual_summary: data.residual_summary(),
+            reference: data.reference.clone(),
+            head: data.head.clone(),
+        }
+    }
+}
+
 /// A trained model and what training found on the way.
 #[derive(Debug)]
 pub struct Trained {
     /// The model, its frame preparation and its quality report set.
     pub model: IcaModel,
-    /// The prepared training data.
-    pub data: PreparedData,
+    /// What preparing the captures found.
+    pub data: PrepReport,
     /// Gaps filled for training.
     pub gaps: GapFill,
     /// The capture's noise per coordinate (mm).
@@ -66,7 +110,30 @@ pub struct Trained {
     pub capped_at_noise: bool,
 }
 
-/// Trains a model on `takes`. See the module docs.
+/// The component rule: the one asked for, or the default share stopped at the noise floor.
+pub(super) fn component_params(options: &TrainOptions, noise_mm: f64) -> FastIcaParams {
+    if options.noise_floor && noise_mm > 0.0 {
+        options
+            .params
+            .clone()
+            .components(Components::VarianceAboveNoise {
+                target: DEFAULT_VARIANCE_TARGET,
+                noise_var: noise_mm * noise_mm,
+            })
+    } else {
+        options.params.clone()
+    }
+}
+
+/// Whether the default variance share was cut short at the noise floor.
+pub(super) fn capped_at_noise(params: &FastIcaParams, model: &IcaModel) -> bool {
+    matches!(
+        params.get_components(),
+        Components::VarianceAboveNoise { .. }
+    ) && model.variance_kept() < DEFAULT_VARIANCE_TARGET
+}
+
+/// Trains a model on `takes` held in memory. See the module docs.
 ///
 /// # Errors
 /// Preparation, gap filling or the fit refusing the data; a fitted model that fails validation.
@@ -79,17 +146,7 @@ pub fn train(
     let data = prepare(takes, &options.prep)?;
     let channels = data.labels.len() * 3;
     let noise_mm = noise_per_coordinate(&training_frames(&data));
-    let params = if options.noise_floor && noise_mm > 0.0 {
-        options
-            .params
-            .clone()
-            .components(Components::VarianceAboveNoise {
-                target: DEFAULT_VARIANCE_TARGET,
-                noise_var: noise_mm * noise_mm,
-            })
-    } else {
-        options.params.clone()
-    };
+    let params = component_params(options, noise_mm);
     // Gaps (occlusions, glitches) are filled for training, so frames with a gap still teach
     // the model; `data` keeps the real samples for the quality report.
     let mut filled = data.samples.clone();
@@ -119,13 +176,10 @@ pub fn train(
         &data,
         options.regions.as_ref(),
     ));
-    let capped_at_noise = matches!(
-        params.get_components(),
-        Components::VarianceAboveNoise { .. }
-    ) && model.variance_kept() < DEFAULT_VARIANCE_TARGET;
+    let capped_at_noise = capped_at_noise(&params, &model);
     Ok(Trained {
         model,
-        data,
+        data: PrepReport::of(&data),
         gaps,
         noise_mm,
         capped_at_noise,

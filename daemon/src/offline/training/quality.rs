@@ -7,7 +7,7 @@ use ica_core::measure::{
     noise_per_coordinate, one_marker_components, residual_by_marker, slow_residual, TrainingFrames,
 };
 use ica_core::model::IcaModel;
-use ica_core::quality::{ModelQuality, WarningKind};
+use ica_core::quality::{HeadReport, ModelQuality, WarningKind};
 use ica_core::stabilise::search::FACE_LEAKAGE;
 use replay::session::Regions;
 
@@ -25,6 +25,17 @@ pub const NOISE_EIGEN_FACTOR: f64 = 2.0;
 /// A slow residual above this (mm RMS at its peak marker) is a signal the model cannot hold.
 pub const SLOW_RESIDUAL_MM: f64 = 1.0;
 
+/// The measures behind the report, taken on the training frames.
+#[derive(Debug, Clone)]
+pub struct Measures {
+    /// Reconstruction residual per marker (mm RMS).
+    pub residual_by_marker_mm: Vec<f64>,
+    /// The slow residual (mm RMS at its peak marker) and the marker.
+    pub slow_residual: Option<(f64, usize)>,
+    /// The capture's noise per coordinate (mm).
+    pub noise_mm: f64,
+}
+
 /// Measures the quality of `model`, trained on `data`; `regions` groups the residuals.
 pub fn assess(model: &IcaModel, data: &PreparedData, regions: Option<&Regions>) -> ModelQuality {
     let frames = TrainingFrames {
@@ -34,21 +45,37 @@ pub fn assess(model: &IcaModel, data: &PreparedData, regions: Option<&Regions>) 
         takes: &data.takes,
         rate_hz: data.rate_hz,
     };
-    let mut q = ModelQuality {
-        head: Some(data.head.clone()),
-        stability: model.report().stability.clone(),
+    let measures = Measures {
         residual_by_marker_mm: residual_by_marker(model, &frames),
+        slow_residual: slow_residual(model, &frames),
+        noise_mm: noise_per_coordinate(&frames),
+    };
+    assess_measured(model, &data.head, measures, regions)
+}
+
+/// The quality report from measures taken already (streaming training takes them while it
+/// reads the frames).
+pub fn assess_measured(
+    model: &IcaModel,
+    head: &HeadReport,
+    measures: Measures,
+    regions: Option<&Regions>,
+) -> ModelQuality {
+    let mut q = ModelQuality {
+        head: Some(head.clone()),
+        stability: model.report().stability.clone(),
+        residual_by_marker_mm: measures.residual_by_marker_mm,
         ..ModelQuality::default()
     };
     q.residual_by_region_mm = by_region(&q.residual_by_marker_mm, model.labels(), regions);
-    if let Some((mm, marker)) = slow_residual(model, &frames) {
+    if let Some((mm, marker)) = measures.slow_residual {
         q.slow_residual_mm = Some(mm);
         q.slow_residual_marker = Some(model.labels()[marker].clone());
     }
     warn_head(&mut q);
     warn_frames(&mut q, model);
     warn_components(&mut q, model);
-    warn_noise(&mut q, model, noise_per_coordinate(&frames));
+    warn_noise(&mut q, model, measures.noise_mm);
     if let (Some(mm), Some(marker)) = (q.slow_residual_mm, q.slow_residual_marker.clone()) {
         if mm > SLOW_RESIDUAL_MM {
             q.warn(

@@ -1,0 +1,153 @@
+//! What preparing learns from the capture before it prepares any frame: the head reference and
+//! its template, then the glitch limits (speed, plausible regions) measured in head
+//! coordinates. The in-memory path learns them from every frame; streaming training from a
+//! bounded sample of whole stretches of takes ([`super::stream`]), the same function on fewer
+//! frames.
+
+use anyhow::Result;
+use ica_core::model::CaptureSettings;
+use ica_core::quality::HeadReport;
+use ica_core::stabilise::{HeadReference, MarkerFrames, Stabiliser};
+
+use super::glitches::{auto_speed, marker_bounds};
+use super::{head, run_prep, PrepOptions, SpeedLimit};
+use crate::offline::ModelFrames;
+
+/// The capture settings learned, with the head decision.
+#[derive(Debug, Clone)]
+pub(super) struct Learned {
+    /// Head reference, speed limit and plausible regions.
+    pub capture: CaptureSettings,
+    /// Reference marker indices (empty without stabilisation).
+    pub reference: Vec<usize>,
+    /// How the head was decided.
+    pub head: HeadReport,
+}
+
+/// Learns the capture settings from `frames` (stretches of takes, in model marker order).
+///
+/// # Errors
+/// Named reference markers that do not resolve, too few of them, or a template that cannot be
+/// fitted.
+pub(super) fn learn(
+    frames: &[ModelFrames],
+    labels: &[String],
+    rate_hz: f64,
+    options: &PrepOptions,
+) -> Result<Learned> {
+    let n = labels.len();
+    // 1. The head: decided on the raw frames, template from them (its Procrustes mean shrugs
+    //    off rare glitches).
+    let raw_missing: Vec<bool> = frames
+        .iter()
+        .flat_map(|f| f.missing.iter().copied())
+        .collect();
+    let raw_xyz: Vec<f32> = frames.iter().flat_map(|f| f.xyz.iter().copied()).collect();
+    let mut ranges = Vec::with_capacity(frames.len());
+    let mut start = 0;
+    for f in frames {
+        ranges.push(start..start + f.frames());
+        start += f.frames();
+    }
+    let raw = MarkerFrames {
+        xyz: &raw_xyz,
+        missing: &raw_missing,
+        markers: n,
+        takes: &ranges,
+    };
+    let decision = head::decide(&options.head, labels, &raw)?;
+    let reference = decision.markers;
+    let head = match reference.len() {
+        0 => None,
+        _ => Some(
+            Stabiliser::fit(&raw_xyz, &raw_missing, n, reference.clone())?
+                .reference()
+                .clone(),
+        ),
+    };
+    drop((raw_xyz, raw_missing));
+    let mut capture = CaptureSettings {
+        head,
+        max_speed_mm_s: None,
+        bounds: None,
+    };
+    // 2. Speeds and plausible regions measured in head coordinates.
+    let (head_xyz, head_missing, _, _) = run_prep(frames, n, rate_hz, &capture)?;
+    capture.max_speed_mm_s = match options.speed {
+        SpeedLimit::Off => None,
+        SpeedLimit::MmPerS(v) => Some(v),
+        SpeedLimit::Auto => auto_speed(&head_xyz, &head_missing, frames, n, rate_hz),
+    };
+    if options.bounds {
+        capture.bounds = Some(marker_bounds(&head_xyz, &head_missing, n));
+    }
+    Ok(Learned {
+        capture,
+        reference,
+        head: decision.report,
+    })
+}
+
+/// RMS distance (mm) of each reference marker from its template place, over prepared
+/// (head-coordinate) frames added one at a time: how rigid the reference held.
+#[derive(Debug, Clone)]
+pub(crate) struct RefResiduals<'a> {
+    head: &'a HeadReference,
+    sq: Vec<f64>,
+    count: Vec<usize>,
+    present: Vec<usize>,
+}
+
+impl<'a> RefResiduals<'a> {
+    pub(crate) fn new(head: &'a HeadReference) -> Self {
+        let k = head.markers.len();
+        Self {
+            head,
+            sq: vec![0.0; k],
+            count: vec![0; k],
+            present: Vec::with_capacity(k),
+        }
+    }
+
+    /// Adds a prepared frame (markers x 3, and its marker mask).
+    pub(crate) fn add_frame(&mut self, xyz: &[f32], missing: &[bool]) {
+        let head = self.head;
+        self.present.clear();
+        self.present
+            .extend((0..head.markers.len()).filter(|&k| !missing[head.markers[k]]));
+        if self.present.len() < 3 {
+            return;
+        }
+        // Head coordinates put the template's centroid where the Procrustes fit put it:
+        // compare the frame's reference shape, centred, to the centred template.
+        let at = |k: usize, a: usize| f64::from(xyz[head.markers[k] * 3 + a]);
+        let share = self.present.len() as f64;
+        let mut c = [0.0; 3];
+        let mut t = [0.0; 3];
+        for &k in &self.present {
+            for a in 0..3 {
+                c[a] += at(k, a) / share;
+                t[a] += head.template[k][a] / share;
+            }
+        }
+        for &k in &self.present {
+            self.sq[k] += (0..3)
+                .map(|a| (at(k, a) - c[a] - (head.template[k][a] - t[a])).powi(2))
+                .sum::<f64>();
+            self.count[k] += 1;
+        }
+    }
+
+    /// Each reference marker's RMS residual, by label.
+    pub(crate) fn by_label(&self, labels: &[String]) -> std::collections::BTreeMap<String, f64> {
+        self.head
+            .markers
+            .iter()
+            .enumerate()
+            .map(|(k, &m)| {
+                let rms = (self.sq[k] / self.count[k].max(1) as f64).sqrt();
+                (labels[m].clone(), rms)
+            })
+            .collect()
+    }
+}

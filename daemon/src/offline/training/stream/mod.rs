@@ -1,0 +1,251 @@
+//! Training on sessions of any length in bounded memory: takes read one at a time, in
+//! batches prepared on a thread pool, never all held.
+//!
+//! 1. [`scan`]: every take read once: the rate, frame counts, which markers stay, and a
+//!    bounded sample ([`SAMPLE_FRAMES`]) the head reference, its template and the glitch
+//!    limits are learned from ([`super::capture::learn`], as the in-memory path learns them
+//!    from every frame). A session of at most [`IN_MEMORY_FRAMES`] frames is kept and trained
+//!    in memory instead ([`super::train`]: identical results, and faster on short sessions).
+//! 2. [`collect`]: every frame prepared once: the moments, the frames with gaps (spilled),
+//!    the glitch counts and what the quality report measures.
+//! 3. [`gaps`]: the gap-filling rounds over the spilled frames only.
+//! 4. [`fit`]: the prepared frames read back, gaps filled, whitened and spilled; the restarts
+//!    on the subsample drawn during that pass; FastICA over the whitened spill, one pass per
+//!    iteration.
+//!
+//! Memory: one batch of takes ([`BATCH_FRAMES`] frames, or one take if longer), the sample,
+//! the covariance and the model, and the quality report's bounded samples; never a copy of the
+//! session. Both halves of every batch and chunk run at once on the pool, and partial sums are
+//! merged in a fixed order, so the model is the same with one thread or several.
+
+mod collect;
+mod fit;
+mod gaps;
+mod read;
+mod sample;
+mod scan;
+mod spill;
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use ica_core::measure::{noise_of_differences, residual_by_marker_of, slow_residual_of_means};
+use ica_core::model::IcaModel;
+use rayon::ThreadPool;
+
+use super::capture::{self, RefResiduals};
+use super::model::{capped_at_noise, component_params};
+use super::quality::{self, Measures};
+use super::{residual_summary, PrepReport, Stage, TrainOptions, Trained};
+use crate::offline::progress::Progress;
+use collect::Collected;
+use rayon::prelude::*;
+use read::{batches, TakePrep};
+
+/// Sessions of at most this many frames (7 minutes at 120 Hz) train in memory.
+pub const IN_MEMORY_FRAMES: usize = 50_000;
+/// Frames the head and the glitch limits are learned from at most (about 3 minutes at 120 Hz,
+/// in stretches of 2 s spread over the session).
+pub const SAMPLE_FRAMES: usize = 20_000;
+/// Frames of takes prepared at once.
+const BATCH_FRAMES: u64 = 16_384;
+
+/// How streaming training runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct StreamOptions {
+    /// Threads of the pool (0: one per core).
+    pub threads: usize,
+    /// Stream even a session short enough to train in memory.
+    pub always_stream: bool,
+}
+
+/// Trains a model on the takes in `paths`, streaming them unless the session is short (see
+/// the module docs).
+///
+/// # Errors
+/// An unreadable take, preparation or the fit refusing the data, a spill file failing, or a
+/// fitted model that fails validation.
+pub fn train_files(
+    paths: &[PathBuf],
+    options: &TrainOptions,
+    stream: &StreamOptions,
+    progress: &mut dyn Progress,
+) -> Result<Trained> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(stream.threads)
+        .build()
+        .context("cannot start the training threads")?;
+    let hold = if stream.always_stream {
+        0
+    } else {
+        IN_MEMORY_FRAMES
+    };
+    let scanned = scan::scan(paths, &options.prep, hold, SAMPLE_FRAMES, &pool, progress)?;
+    if let Some(takes) = &scanned.held {
+        let mut stage = |s: Stage| match s {
+            Stage::Preparing => progress.step("preparing in memory", "takes", None),
+            Stage::Fitting { restarts } => progress.step(
+                &format!("whitening and FastICA ({restarts} restarts) in memory"),
+                "restarts",
+                None,
+            ),
+        };
+        return super::train(takes, options, &mut stage);
+    }
+    streamed(scanned, options, &pool, progress)
+}
+
+fn streamed(
+    scanned: scan::Scan,
+    options: &TrainOptions,
+    pool: &ThreadPool,
+    progress: &mut dyn Progress,
+) -> Result<Trained> {
+    progress.step("learning the head and glitch limits", "frames", None);
+    let learned = capture::learn(
+        &scanned.sample,
+        &scanned.labels,
+        scanned.rate_hz,
+        &options.prep,
+    )?;
+    let total = scanned.total_frames();
+    let (scanned, raw) = scanned.take_raw()?;
+    let (mut collected, head_residuals) = statistics(&scanned, raw, &learned, pool, progress)?;
+    let noise_mm = noise_of_differences(&mut collected.noise_d2);
+    let params = component_params(options, noise_mm);
+    // Pass 3: the gaps.
+    let filled = gaps::fill(&mut collected, params.get_components(), pool, progress)?;
+    // Pass 4: the prepared frames, gaps filled, whitened; then FastICA over the spill.
+    let (prepared, c) = (&mut collected.prepared, collected.channels);
+    let mut source = |each: &mut fit::FrameBatch<'_>| {
+        collect::for_each_prepared(prepared, c, BATCH_FRAMES as usize, &mut |values, mask| {
+            if let Some(model) = &filled.model {
+                fill_batch(model, &filled.seen, values, mask, pool);
+            }
+            each(values, mask)
+        })
+    };
+    let fit = fit::fit(&params, filled.moments, total, &mut source, pool, progress)?;
+    progress.finish();
+    let mut model = IcaModel::new(
+        scanned.labels.clone(),
+        scanned.rate_hz,
+        fit.mean,
+        fit.mixing,
+        fit.report,
+    )
+    .context("the fitted model failed validation")?;
+    model.set_capture(learned.capture.clone())?;
+    let mut head = learned.head.clone();
+    if let Some(residuals) = head_residuals {
+        head.residual_mm = residuals;
+    }
+    let c = collected.channels;
+    let measures = Measures {
+        residual_by_marker_mm: residual_by_marker_of(
+            &model,
+            collected.residual_frames.chunks_exact(c),
+        ),
+        slow_residual: slow_residual_of_means(&model, &collected.slow_means),
+        noise_mm,
+    };
+    model.set_quality(quality::assess_measured(
+        &model,
+        &head,
+        measures,
+        options.regions.as_ref(),
+    ));
+    let capped_at_noise = capped_at_noise(&params, &model);
+    let data = PrepReport {
+        labels: scanned.labels,
+        rate_hz: scanned.rate_hz,
+        capture: learned.capture,
+        excluded: scanned.excluded,
+        resampled: scanned.resampled,
+        glitches: collected.glitches,
+        glitches_per_marker: collected.glitches_per_marker,
+        residual_summary: residual_summary(&collected.residuals.values),
+        reference: learned
+            .reference
+            .iter()
+            .map(|&i| model.labels()[i].clone())
+            .collect(),
+        head,
+    };
+    Ok(Trained {
+        model,
+        data,
+        gaps: filled.report,
+        noise_mm,
+        capped_at_noise,
+    })
+}
+
+/// Pass 2: every spilled frame prepared and collected; each reference marker's residual.
+fn statistics(
+    scanned: &scan::Scan,
+    mut raw: spill::Spill,
+    learned: &capture::Learned,
+    pool: &ThreadPool,
+    progress: &mut dyn Progress,
+) -> Result<(Collected, Option<BTreeMap<String, f64>>)> {
+    let total = scanned.total_frames();
+    progress.step("statistics", "frames", Some(total as u64));
+    let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz)?;
+    let mut refs = learned.capture.head.as_ref().map(RefResiduals::new);
+    let prep = TakePrep {
+        kept: &scanned.kept,
+        spilled_markers: scanned.first_markers,
+        rate_hz: scanned.rate_hz,
+        capture: &learned.capture,
+    };
+    let frames = &scanned.take_frames;
+    let sizes: Vec<u64> = frames.iter().map(|&f| f as u64).collect();
+    let batches = batches(&sizes, BATCH_FRAMES);
+    let groups: Vec<usize> = batches
+        .iter()
+        .map(|r| frames[r.clone()].iter().sum())
+        .collect();
+    let record = 13 * scanned.first_markers;
+    raw.for_each_group(&groups, &mut |b, bytes| {
+        let mut starts = vec![0];
+        for &f in &frames[batches[b].clone()] {
+            starts.push(starts.last().copied().unwrap_or(0) + f * record);
+        }
+        let batch = pool.install(|| {
+            starts
+                .par_windows(2)
+                .map(|w| prep.prepare(&bytes[w[0]..w[1]]))
+                .collect::<Result<Vec<_>>>()
+        })?;
+        collected.add_batch(&batch, refs.as_mut(), pool)?;
+        progress.advance(groups[b] as u64);
+        Ok(())
+    })?;
+    let residuals = refs.map(|r| r.by_label(&scanned.labels));
+    Ok((collected, residuals))
+}
+
+/// Fills the gaps of a batch's frames that have some (as [`collect`] spilled them).
+fn fill_batch(
+    model: &ica_core::impute::GapModel,
+    seen: &[bool],
+    values: &mut [f32],
+    mask: &mut [bool],
+    pool: &ThreadPool,
+) {
+    use ica_core::impute::{frame_gaps, FrameGaps};
+    let c = seen.len();
+    let fill = |v: &mut [f32], m: &mut [bool]| {
+        for (x, g) in v.chunks_exact_mut(c).zip(m.chunks_exact_mut(c)) {
+            if frame_gaps(g) == FrameGaps::Fill {
+                gaps::fill_frames(model, seen, x, g);
+            }
+        }
+    };
+    let mid = values.len() / c / 2 * c;
+    let (vl, vr) = values.split_at_mut(mid);
+    let (ml, mr) = mask.split_at_mut(mid);
+    pool.join(|| fill(vl, ml), || fill(vr, mr));
+}

@@ -1,0 +1,166 @@
+//! Reading takes for streaming training: in batches loaded (or read back from the first
+//! pass's spill) and prepared on the pool, handed to the caller one batch at a time, in take
+//! order, so the passes stay deterministic whatever the thread count and memory holds one
+//! batch.
+
+use anyhow::Result;
+use ica_core::model::CaptureSettings;
+use rayon::prelude::*;
+use rayon::ThreadPool;
+use replay::Take;
+use std::ops::Range;
+
+use super::sample::narrow;
+use super::spill::f32_values;
+use crate::engine::frame::FramePrep;
+use crate::offline::ModelFrames;
+
+/// Consecutive items whose sizes add up to about `target` (at least one item each).
+pub(super) fn batches(sizes: &[u64], target: u64) -> Vec<Range<usize>> {
+    let mut out = Vec::new();
+    let (mut start, mut sum) = (0, 0u64);
+    for (i, &size) in sizes.iter().enumerate() {
+        sum += size;
+        if sum >= target {
+            out.push(start..i + 1);
+            start = i + 1;
+            sum = 0;
+        }
+    }
+    if start < sizes.len() {
+        out.push(start..sizes.len());
+    }
+    out
+}
+
+/// Loads every item of each batch on the pool with `load`, then calls `each` with the batch's
+/// results in order; stops at the first error.
+///
+/// # Errors
+/// The first error of `load` or `each`.
+pub(super) fn for_each_batch<T: Send>(
+    pool: &ThreadPool,
+    batches: &[Range<usize>],
+    load: &(dyn Fn(usize) -> Result<T> + Sync),
+    each: &mut dyn FnMut(Range<usize>, Vec<T>) -> Result<()>,
+) -> Result<()> {
+    for range in batches {
+        let loaded: Vec<T> = pool.install(|| {
+            range
+                .clone()
+                .into_par_iter()
+                .map(load)
+                .collect::<Result<Vec<T>>>()
+        })?;
+        each(range.clone(), loaded)?;
+    }
+    Ok(())
+}
+
+/// The take resampled to the model rate, when its rate differs (as the in-memory path
+/// decides).
+pub(super) fn at_rate(take: &Take, rate_hz: f64) -> Option<Take> {
+    ((take.rate_hz - rate_hz).abs() > 1e-6 * rate_hz).then(|| take.resampled(rate_hz))
+}
+
+/// One take through the frame preparation training uses (glitches, head coordinates).
+#[derive(Debug)]
+pub(super) struct PreparedTake {
+    /// Frames.
+    pub frames: usize,
+    /// Prepared positions, frames x markers x 3.
+    pub xyz: Vec<f32>,
+    /// Missing after preparation (glitches included), frames x markers.
+    pub missing: Vec<bool>,
+    /// Missing in the file, frames x markers (model order).
+    pub raw_missing: Vec<bool>,
+    /// Samples dropped as glitches.
+    pub glitches: usize,
+    /// Stabilisation residual of each frame whose pose was estimated (mm).
+    pub residuals: Vec<f64>,
+}
+
+/// What preparing a take needs: the model's markers, rate and capture settings.
+#[derive(Debug, Clone)]
+pub(super) struct TakePrep<'a> {
+    /// The kept markers' indices among the spilled frames' markers.
+    pub kept: &'a [usize],
+    /// Markers of a spilled frame.
+    pub spilled_markers: usize,
+    pub rate_hz: f64,
+    pub capture: &'a CaptureSettings,
+}
+
+impl TakePrep<'_> {
+    /// Prepares every frame of a take spilled by the first pass ([`super::scan`]).
+    ///
+    /// # Errors
+    /// A frame buffer that does not match the markers (an internal invariant).
+    pub(super) fn prepare(&self, bytes: &[u8]) -> Result<PreparedTake> {
+        let raw = narrow(&self.unspill(bytes), self.kept);
+        let n = self.kept.len();
+        let frames = raw.frames();
+        let mut prep = FramePrep::new(n, self.rate_hz, self.capture);
+        let mut out = PreparedTake {
+            frames,
+            xyz: Vec::with_capacity(frames * n * 3),
+            missing: Vec::with_capacity(frames * n),
+            raw_missing: Vec::new(),
+            glitches: 0,
+            residuals: Vec::new(),
+        };
+        for f in 0..frames {
+            let (p, m) = raw.frame(f);
+            let done = prep.prepare(p, m)?;
+            out.xyz.extend_from_slice(done.xyz);
+            out.missing.extend_from_slice(done.missing);
+            out.glitches += done.info.glitches;
+            if done.info.pose.is_some() && !done.info.pose_held {
+                out.residuals.push(done.info.residual_mm);
+            }
+        }
+        out.raw_missing = raw.missing;
+        Ok(out)
+    }
+
+    /// The spilled frames back as positions and mask.
+    fn unspill(&self, bytes: &[u8]) -> ModelFrames {
+        let n = self.spilled_markers;
+        let (mut xyz, mut missing, mut frame) = (Vec::new(), Vec::new(), Vec::new());
+        for record in bytes.chunks_exact(13 * n) {
+            f32_values(&record[..12 * n], &mut frame);
+            xyz.extend_from_slice(&frame);
+            missing.extend(record[12 * n..].iter().map(|&b| b != 0));
+        }
+        ModelFrames {
+            xyz,
+            missing,
+            markers: n,
+        }
+    }
+}
+
+/// A batch of prepared takes as the fit reads frames: values (frames x channels) and the
+/// per-channel missing mask.
+pub(super) fn channel_arrays(batch: &[PreparedTake]) -> (Vec<f32>, Vec<bool>) {
+    let values: usize = batch.iter().map(|t| t.xyz.len()).sum();
+    let mut samples = Vec::with_capacity(values);
+    let mut mask = Vec::with_capacity(values);
+    for t in batch {
+        samples.extend_from_slice(&t.xyz);
+        mask.extend(t.missing.iter().flat_map(|&m| [m, m, m]));
+    }
+    (samples, mask)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn batches_cover_every_item_once() {
+        assert_eq!(batches(&[5, 5, 5, 30, 1], 10), vec![0..2, 2..4, 4..5]);
+        assert_eq!(batches(&[], 10), Vec::<Range<usize>>::new());
+        assert_eq!(batches(&[100], 10), vec![0..1]);
+    }
+}

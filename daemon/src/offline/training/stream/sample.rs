@@ -1,0 +1,188 @@
+//! The bounded sample streaming training learns the head and the glitch limits from: whole
+//! stretches of [`SEGMENT_FRAMES`] consecutive frames, evenly spread over the session, at most
+//! [`super::SAMPLE_FRAMES`] in all, drawn while the takes stream past without knowing the
+//! session's length in advance.
+//!
+//! Every segment gets a running index; segments whose index is a multiple of the stride are
+//! kept. When the kept frames pass the budget the stride doubles and every other kept segment
+//! is dropped, so the sample stays evenly spread and between half the budget and the budget.
+//! A session within the budget is sampled whole: its takes come back exactly as they were.
+
+use crate::offline::ModelFrames;
+
+/// Frames per sampled stretch: 2 s at 120 Hz, long enough for the speeds and second
+/// differences the glitch limits and the head search read.
+pub const SEGMENT_FRAMES: usize = 240;
+
+/// A stretch of one take.
+#[derive(Debug)]
+struct Segment {
+    index: usize,
+    take: usize,
+    start: usize,
+    frames: ModelFrames,
+}
+
+/// Collects the sample (see the module docs).
+#[derive(Debug)]
+pub(super) struct Sampler {
+    budget: usize,
+    stride: usize,
+    next: usize,
+    kept_frames: usize,
+    kept: Vec<Segment>,
+}
+
+impl Sampler {
+    /// An empty sample of at most `budget` frames.
+    pub(super) fn new(budget: usize) -> Self {
+        Self {
+            budget: budget.max(SEGMENT_FRAMES),
+            stride: 1,
+            next: 0,
+            kept_frames: 0,
+            kept: Vec::new(),
+        }
+    }
+
+    /// Offers take number `take` of `total` frames; `gather` gives a range of its frames in
+    /// the sample's marker order (called only for the stretches kept).
+    pub(super) fn push(
+        &mut self,
+        take: usize,
+        total: usize,
+        gather: &dyn Fn(std::ops::Range<usize>) -> ModelFrames,
+    ) {
+        for start in (0..total).step_by(SEGMENT_FRAMES) {
+            let index = self.next;
+            self.next += 1;
+            if index % self.stride != 0 {
+                continue;
+            }
+            let end = (start + SEGMENT_FRAMES).min(total);
+            self.kept.push(Segment {
+                index,
+                take,
+                start,
+                frames: gather(start..end),
+            });
+            self.kept_frames += end - start;
+            while self.kept_frames > self.budget {
+                self.thin();
+            }
+        }
+    }
+
+    /// Doubles the stride and drops the segments it no longer keeps.
+    fn thin(&mut self) {
+        self.stride *= 2;
+        let stride = self.stride;
+        self.kept.retain(|s| s.index % stride == 0);
+        self.kept_frames = self.kept.iter().map(|s| s.frames.frames()).sum();
+    }
+
+    /// The sample as stretches of takes (neighbouring segments of a take joined), with its
+    /// markers narrowed to `markers` (indices into the order it was collected in).
+    pub(super) fn finish(self, markers: &[usize]) -> Vec<ModelFrames> {
+        let mut out: Vec<ModelFrames> = Vec::new();
+        let mut last: Option<(usize, usize)> = None;
+        for s in self.kept {
+            let narrowed = narrow(&s.frames, markers);
+            let end = s.start + narrowed.frames();
+            match (last, out.last_mut()) {
+                (Some((take, at)), Some(prev)) if take == s.take && at == s.start => {
+                    prev.xyz.extend_from_slice(&narrowed.xyz);
+                    prev.missing.extend_from_slice(&narrowed.missing);
+                }
+                _ => out.push(narrowed),
+            }
+            last = Some((s.take, end));
+        }
+        out
+    }
+}
+
+/// Frames `range` of `frames`.
+pub(super) fn frames_range(frames: &ModelFrames, range: std::ops::Range<usize>) -> ModelFrames {
+    let n = frames.markers;
+    ModelFrames {
+        xyz: frames.xyz[range.start * n * 3..range.end * n * 3].to_vec(),
+        missing: frames.missing[range.start * n..range.end * n].to_vec(),
+        markers: n,
+    }
+}
+
+/// `frames` with only `markers`, in that order.
+pub(super) fn narrow(frames: &ModelFrames, markers: &[usize]) -> ModelFrames {
+    let n = frames.markers;
+    let count = frames.frames();
+    let mut xyz = Vec::with_capacity(count * markers.len() * 3);
+    let mut missing = Vec::with_capacity(count * markers.len());
+    for f in 0..count {
+        for &m in markers {
+            xyz.extend_from_slice(&frames.xyz[(f * n + m) * 3..(f * n + m) * 3 + 3]);
+            missing.push(frames.missing[f * n + m]);
+        }
+    }
+    ModelFrames {
+        xyz,
+        missing,
+        markers: markers.len(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn take(frames: usize, value: f32) -> ModelFrames {
+        ModelFrames {
+            xyz: (0..frames * 3).map(|i| value + i as f32).collect(),
+            missing: vec![false; frames],
+            markers: 1,
+        }
+    }
+
+    fn push(s: &mut Sampler, i: usize, t: &ModelFrames) {
+        s.push(i, t.frames(), &|r| ModelFrames {
+            xyz: t.xyz[r.start * 3..r.end * 3].to_vec(),
+            missing: t.missing[r].to_vec(),
+            markers: 1,
+        });
+    }
+
+    #[test]
+    fn a_session_within_the_budget_comes_back_whole() {
+        let mut s = Sampler::new(10_000);
+        let takes = [take(500, 0.0), take(37, 1e5), take(1_000, 2e5)];
+        for (i, t) in takes.iter().enumerate() {
+            push(&mut s, i, t);
+        }
+        let out = s.finish(&[0]);
+        assert_eq!(out.len(), 3);
+        for (got, want) in out.iter().zip(&takes) {
+            assert_eq!(got.xyz, want.xyz);
+        }
+    }
+
+    #[test]
+    fn a_long_session_is_sampled_evenly_within_the_budget() {
+        let mut s = Sampler::new(5_000);
+        for i in 0..400 {
+            push(&mut s, i, &take(1_000, i as f32 * 1e4));
+        }
+        let stride = s.stride;
+        let out = s.finish(&[0]);
+        let frames: usize = out.iter().map(ModelFrames::frames).sum();
+        assert!((2_500..=5_000).contains(&frames), "{frames} frames");
+        // Kept segments are evenly spaced, from the first take to within one stride (of 5
+        // segments a take) of the last.
+        assert!(stride > 1);
+        assert_eq!(out[0].xyz[0], 0.0);
+        let last_take = out.last().expect("kept").xyz[0] / 1e4;
+        assert!(
+            last_take >= (400 - stride / 5 - 1) as f32,
+            "last take {last_take}, stride {stride}"
+        );
+    }
+}

@@ -1,0 +1,168 @@
+//! The first pass of streaming training: every take read once for what must be known before
+//! any frame is prepared. The model rate, each take's frame count, how often each marker is
+//! missing (which markers the model keeps) and a bounded sample of the capture
+//! ([`super::sample`]). The frames, at the model rate in the first take's marker order, go to
+//! a spill file, so the next pass reads them back instead of decoding every file again. A
+//! session no longer than the in-memory limit is kept whole, for the in-memory path.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use rayon::ThreadPool;
+
+use super::read::{at_rate, batches, for_each_batch};
+use super::sample::{frames_range, Sampler};
+use super::spill::{f32_bytes, Spill};
+use crate::engine::layout::LabelMap;
+use crate::offline::progress::Progress;
+use crate::offline::takes::frames_in_model_order;
+use crate::offline::training::{MissingCounts, PrepOptions};
+use crate::offline::{load_take, LoadedTake, ModelFrames};
+
+/// Bytes of take files loaded at once in the first pass.
+const SCAN_BATCH_BYTES: u64 = 64 << 20;
+
+/// What the first pass found.
+#[derive(Debug)]
+pub(super) struct Scan {
+    /// Model rate.
+    pub rate_hz: f64,
+    /// Markers kept, in the first take's order.
+    pub labels: Vec<String>,
+    /// Markers left out, with the share of frames they were missing in.
+    pub excluded: Vec<(String, f64)>,
+    /// Takes resampled: file, from rate, to rate.
+    pub resampled: Vec<(String, f64, f64)>,
+    /// Frames of each take at the model rate.
+    pub take_frames: Vec<usize>,
+    /// The bounded sample, in the kept markers' order.
+    pub sample: Vec<ModelFrames>,
+    /// Markers of the first take (the order of the spilled frames).
+    pub first_markers: usize,
+    /// The kept markers' indices among the first take's.
+    pub kept: Vec<usize>,
+    /// Every frame at the model rate in the first take's marker order: positions (f32), then
+    /// one missing byte per marker (taken out by [`Scan::take_raw`]).
+    pub raw: Option<Spill>,
+    /// Every take as loaded, when the session is within the in-memory limit.
+    pub held: Option<Vec<LoadedTake>>,
+}
+
+impl Scan {
+    /// The spilled frames, taken out (the rest of the scan stays usable).
+    pub(super) fn take_raw(mut self) -> Result<(Self, Spill)> {
+        let raw = self.raw.take().context("the frames were spilled once")?;
+        Ok((self, raw))
+    }
+
+    /// Frames in the session.
+    pub(super) fn total_frames(&self) -> usize {
+        self.take_frames.iter().sum()
+    }
+}
+
+/// Reads every take once (see the module docs); keeps them when the session has at most
+/// `hold_frames` frames.
+///
+/// # Errors
+/// No take, an unreadable take, a take that shares no marker with the first, or every marker
+/// missing too often.
+pub(super) fn scan(
+    paths: &[PathBuf],
+    prep: &PrepOptions,
+    hold_frames: usize,
+    sample_frames: usize,
+    pool: &ThreadPool,
+    progress: &mut dyn Progress,
+) -> Result<Scan> {
+    progress.step("reading takes", "takes", Some(paths.len() as u64));
+    let first_path = paths.first().context("no takes given")?;
+    let first = load_take(first_path)?;
+    let rate_hz = prep.rate_hz.unwrap_or(first.rate_hz);
+    let first_labels = first.labels.clone();
+    drop(first);
+    let mut counts = MissingCounts::new(first_labels.clone());
+    let mut sampler = Sampler::new(sample_frames);
+    let mut scan = Scan {
+        rate_hz,
+        labels: Vec::new(),
+        excluded: Vec::new(),
+        resampled: Vec::new(),
+        take_frames: Vec::with_capacity(paths.len()),
+        sample: Vec::new(),
+        first_markers: first_labels.len(),
+        kept: Vec::new(),
+        raw: None,
+        held: Some(Vec::new()),
+    };
+    let mut bytes = Vec::new();
+    let mut raw = Spill::new(first_labels.len() * 13)?;
+    let sizes: Vec<u64> = paths
+        .iter()
+        .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
+        .collect();
+    let load = |i: usize| {
+        let take = load_take(&paths[i])?;
+        let at_rate = at_rate(&take, rate_hz);
+        Ok((take, at_rate))
+    };
+    for_each_batch(
+        pool,
+        &batches(&sizes, SCAN_BATCH_BYTES),
+        &load,
+        &mut |range, loaded| {
+            for (i, (original, at_rate)) in range.zip(loaded) {
+                let path = &paths[i];
+                if at_rate.is_some() {
+                    scan.resampled
+                        .push((path.display().to_string(), original.rate_hz, rate_hz));
+                }
+                let take = at_rate.as_ref().unwrap_or(&original);
+                counts
+                    .add(take)
+                    .with_context(|| format!("{}", path.display()))?;
+                let map = LabelMap::new(&first_labels, &take.labels)
+                    .with_context(|| format!("{}", path.display()))?;
+                let all = frames_in_model_order(take, &map, 0..take.n_frames());
+                sampler.push(i, all.frames(), &|r| frames_range(&all, r));
+                bytes.clear();
+                for f in 0..all.frames() {
+                    let (xyz, missing) = all.frame(f);
+                    f32_bytes(xyz, &mut bytes);
+                    bytes.extend(missing.iter().map(|&m| u8::from(m)));
+                }
+                raw.push(&bytes)?;
+                scan.take_frames.push(take.n_frames());
+                scan.held = match scan.held.take() {
+                    Some(mut held) if scan.take_frames.iter().sum::<usize>() <= hold_frames => {
+                        // The in-memory path resamples by itself.
+                        held.push(LoadedTake {
+                            path: path.clone(),
+                            take: original,
+                        });
+                        Some(held)
+                    }
+                    _ => None,
+                };
+                progress.advance(1);
+            }
+            Ok(())
+        },
+    )?;
+    let (labels, excluded) = counts.kept(prep.max_missing_share)?;
+    let kept: Vec<usize> = labels
+        .iter()
+        .map(|l| {
+            first_labels
+                .iter()
+                .position(|f| f == l)
+                .expect("kept labels come from the first take's")
+        })
+        .collect();
+    scan.raw = Some(raw);
+    scan.sample = sampler.finish(&kept);
+    scan.kept = kept;
+    scan.labels = labels;
+    scan.excluded = excluded;
+    Ok(scan)
+}

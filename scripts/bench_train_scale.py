@@ -1,0 +1,96 @@
+"""Helper of scripts/bench-train-scale.
+
+  bench_train_scale.py fit SESSION.toml   scikit-learn FastICA on the session's frames; prints
+                                          "fit_s peak_rss_kb frames iterations converged"
+  bench_train_scale.py report RESULTS     the table (medians, spread, frames/s, exponent)
+"""
+import math
+import os
+import resource
+import statistics
+import sys
+import time
+import tomllib
+
+
+def load_frames(manifest):
+    import ezc3d
+    import numpy as np
+
+    base = os.path.dirname(manifest)
+    with open(manifest, "rb") as f:
+        session = tomllib.load(f)
+    rows = []
+    for take in session["take"]:
+        c = ezc3d.c3d(os.path.join(base, take["file"]))
+        points = c["data"]["points"][:3]  # 3 x markers x frames
+        rows.append(points.transpose(2, 1, 0).reshape(points.shape[2], -1))
+    return np.ascontiguousarray(np.vstack(rows), dtype=np.float64)
+
+
+def fit(manifest):
+    from sklearn.decomposition import FastICA
+
+    x = load_frames(manifest)
+    ica = FastICA(n_components=20, whiten="unit-variance", max_iter=1000, tol=1e-4,
+                  random_state=0)
+    start = time.perf_counter()
+    ica.fit(x)
+    seconds = time.perf_counter() - start
+    rss_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    print(f"{seconds:.2f} {rss_kb} {x.shape[0]} {ica.n_iter_} {int(ica.n_iter_ < 1000)}")
+
+
+def spread(values):
+    return f"{statistics.median(values):.2f} ({min(values):.2f}-{max(values):.2f})"
+
+
+def report(path):
+    train, sk, one = {}, {}, {}
+    with open(path) as f:
+        for line in f:
+            kind, size, *rest = line.split()
+            if kind == "train":
+                train.setdefault(size, []).append([float(v) for v in rest])
+            elif kind == "train1":
+                one[size] = [float(v) for v in rest]
+            else:
+                sk.setdefault(size, []).append([float(v) for v in rest])
+    print("\n| session | frames | train wall s, median (min-max) | peak RSS MB | frames/s | "
+          "µs per frame | sklearn fit s | sklearn RSS MB | sklearn iterations |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    points = []
+    for size, runs in train.items():
+        frames = int(runs[0][2])
+        walls = [r[0] for r in runs]
+        rss = max(r[1] for r in runs) / 1024
+        med = statistics.median(walls)
+        if size != "12k":
+            points.append((frames, med))
+        s = sk.get(size)
+        sk_cols = " — | — | — "
+        if s:
+            sk_cols = (f" {spread([r[0] for r in s])} | {max(r[1] for r in s) / 1024:.0f} | "
+                       f"{int(s[0][3])}{'' if s[0][4] else ' (not converged)'} ")
+        print(f"| {size} | {frames:,} | {spread(walls)} | {rss:.0f} | {frames / med:,.0f} | "
+              f"{1e6 * med / frames:.1f} |{sk_cols}|")
+    if len(points) >= 2:
+        xs = [math.log(f) for f, _ in points]
+        ys = [math.log(t) for _, t in points]
+        mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+        slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+        per = [t / f for f, t in points]
+        print(f"\nscaling exponent (time ~ frames^k): k = {slope:.3f}; time per frame, largest "
+              f"session / smallest: {per[-1] / per[0]:.3f}")
+    for size, r in one.items():
+        two = statistics.median(x[0] for x in train[size])
+        print(f"{size} on one thread: {r[0]:.2f} s; on all cores {two:.2f} s ({r[0] / two:.2f}x speed-up)")
+    if "12k" in train and "12k" in sk:
+        ours = statistics.median(r[0] for r in train["12k"])
+        theirs = statistics.median(r[0] for r in sk["12k"])
+        print(f"12,000 frames: whole `train` command {ours:.2f} s, sklearn converged fit "
+              f"{theirs:.2f} s: ratio {ours / theirs:.2f}")
+
+
+if __name__ == "__main__":
+    {"fit": lambda: fit(sys.argv[2]), "report": lambda: report(sys.argv[2])}[sys.argv[1]]()
