@@ -39,6 +39,8 @@ pub struct RawPerformer {
     pub source: Option<String>,
     /// Layout id whose frames are this performer's.
     pub layout: Option<i32>,
+    /// NatNet markerset (Motive asset) whose frames are this performer's.
+    pub markerset: Option<String>,
     /// Default target emotion.
     pub emotion: Option<String>,
     /// Default amount.
@@ -350,6 +352,7 @@ fn performer(p: RawPerformer) -> Result<PerformerConfig, ConfigError> {
         model: p.model,
         source,
         layout: p.layout,
+        markerset: p.markerset,
         target: p.emotion,
         amount: p.amount,
     })

@@ -130,6 +130,7 @@ impl Stats {
             ("restarts", c.restarts),
             ("model_swaps", c.model_swaps),
             ("bad_packets", c.bad_total()),
+            ("bad_natnet", c.bad_natnet),
             ("control_refused", self.control_refused),
             ("datagrams_sent", self.send.datagrams_sent),
             ("send_errors", self.send.send_errors),
