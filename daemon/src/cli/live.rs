@@ -26,6 +26,20 @@ pub struct ServeArgs {
     /// Low-pass window of the emotion edit, seconds [default: 1].
     #[arg(long)]
     pub lowpass: Option<f32>,
+    /// Take frames from an OptiTrack Motive NatNet server: its command channel, IP[:PORT]
+    /// [port 1510]. Each markerset becomes a stream, beside the OSC frame socket.
+    #[arg(long, value_name = "SERVER[:PORT]")]
+    pub natnet: Option<String>,
+    /// Where NatNet frames arrive: a multicast group (joined on --natnet-interface) or a
+    /// local unicast address [default: what the server announces].
+    #[arg(long, value_name = "ADDR:PORT", requires = "natnet")]
+    pub natnet_data: Option<String>,
+    /// Local IPv4 address to join the NatNet multicast group on.
+    #[arg(long, value_name = "IP", requires = "natnet")]
+    pub natnet_interface: Option<String>,
+    /// Rate of Motive's timecode, which NatNet does not send (24, 25, 29.97df, 30, 59.94df...).
+    #[arg(long, value_name = "RATE", requires = "natnet")]
+    pub natnet_timecode_rate: Option<String>,
 }
 
 /// `emoshift bench`.

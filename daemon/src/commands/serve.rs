@@ -38,6 +38,16 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if let Some(l) = args.lowpass {
         raw.lowpass_s = Some(l);
     }
+    for (flag, key) in [
+        (&args.natnet, &mut raw.natnet),
+        (&args.natnet_data, &mut raw.natnet_data),
+        (&args.natnet_interface, &mut raw.natnet_interface),
+        (&args.natnet_timecode_rate, &mut raw.natnet_timecode_rate),
+    ] {
+        if let Some(v) = flag {
+            *key = Some(v.clone());
+        }
+    }
     raw.validate().map_err(|e| UsageError(e.to_string()).into())
 }
 

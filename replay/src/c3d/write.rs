@@ -46,6 +46,7 @@ pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
     let meta = Meta {
         labels: &take.labels,
         rate_hz: take.rate_hz,
+        time: None,
     };
     let blocks = parameter_blocks(&meta, &range)?;
     out.write_all(&head(&meta, &range, blocks))?;
@@ -64,6 +65,8 @@ pub(crate) struct Meta<'a> {
     pub(crate) labels: &'a [String],
     /// Frame rate, Hz.
     pub(crate) rate_hz: f64,
+    /// A recording's timecode and measured rate.
+    pub(crate) time: Option<&'a crate::record::RecordTime>,
 }
 
 /// Rejects labels C3D cannot hold: too many markers, a label over 255 bytes.
@@ -215,6 +218,7 @@ const POINT: i8 = 1;
 const ANALOG: i8 = 2;
 const FORCE_PLATFORM: i8 = 3;
 const TRIAL: i8 = 4;
+const TIMECODE: i8 = 5;
 
 fn parameters(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> Vec<u8> {
     let mut w = Records::default();
@@ -256,7 +260,51 @@ fn parameters(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> Vec<u8> {
     let words = |v: u32| [(v & 0xFFFF) as u16, (v >> 16) as u16];
     w.int(TRIAL, "ACTUAL_START_FIELD", &words(range.first));
     w.int(TRIAL, "ACTUAL_END_FIELD", &words(range.last));
+    if let Some(rate) = meta.time.and_then(|t| t.camera_rate_hz) {
+        w.float(TRIAL, "CAMERA_RATE", &[rate as f32]);
+    }
+    if let Some(tc) = meta.time.and_then(|t| t.timecode) {
+        timecode_group(&mut w, &tc, meta.rate_hz);
+    }
     w.finish()
+}
+
+/// The TIMECODE group as Vicon writes it (read by e.g. mocap.ca's translators): USED, DROP_FRAMES,
+/// STANDARD (NTSC, PAL or FILM by nominal rate), SUBFRAMESPERFRAME (capture frames per
+/// timecode frame), OFFSETS (the first frame's subframe), TIMECODES (hh mm ss ff of the first
+/// frame); and RATE, the exact timecode rate, which STANDARD cannot say (29.97, 59.94).
+fn timecode_group(w: &mut Records, tc: &protocol::Smpte, rate_hz: f64) {
+    let fps = tc.rate.map_or(0.0, |r| r.fps());
+    let nominal = tc.rate.map_or(0, |r| r.nominal_fps());
+    w.group(TIMECODE, "TIMECODE", "SMPTE timecode of the first frame");
+    w.int(TIMECODE, "USED", &[1]);
+    w.byte(
+        TIMECODE,
+        "DROP_FRAMES",
+        u8::from(tc.rate.is_some_and(|r| r.drop_frame())),
+    );
+    let standard = match nominal {
+        30 | 60 => "NTSC".to_string(),
+        25 | 50 => "PAL".to_string(),
+        24 => "FILM".to_string(),
+        n => n.to_string(),
+    };
+    w.chars(TIMECODE, "STANDARD", &[standard]);
+    let per_frame = if fps > 0.0 {
+        (rate_hz / fps).round().max(1.0)
+    } else {
+        1.0
+    };
+    w.int_dims(TIMECODE, "SUBFRAMESPERFRAME", &[1, 1], &[per_frame as u16]);
+    w.int_dims(
+        TIMECODE,
+        "OFFSETS",
+        &[1, 1],
+        &[tc.subframe.min(u32::from(u16::MAX)) as u16],
+    );
+    let hmsf = [tc.hours, tc.minutes, tc.seconds, tc.frames].map(u16::from);
+    w.int_dims(TIMECODE, "TIMECODES", &[4, 1], &hmsf);
+    w.float(TIMECODE, "RATE", &[fps as f32]);
 }
 
 /// Builds group and parameter records; each record's "offset to next" is patched when the next
@@ -307,6 +355,17 @@ impl Records {
         self.param(group, name, 2, &dims, &data);
     }
 
+    /// 16-bit integers with explicit dimensions (Vicon's TIMECODE group stores even single
+    /// values as 1 x 1 arrays).
+    fn int_dims(&mut self, group: i8, name: &str, dims: &[u8], values: &[u16]) {
+        let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        self.param(group, name, 2, dims, &data);
+    }
+
+    fn byte(&mut self, group: i8, name: &str, value: u8) {
+        self.param(group, name, 1, &[], &[value]);
+    }
+
     fn float(&mut self, group: i8, name: &str, values: &[f32]) {
         let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
         let dims = if values.len() == 1 {
@@ -353,6 +412,7 @@ mod tests {
         let meta = Meta {
             labels: &take.labels,
             rate_hz: take.rate_hz,
+            time: None,
         };
         let mut params = parameters(&meta, &range, 3);
         // Append an EVENT group to the finished section: patch the last record's zero offset.
