@@ -3,7 +3,7 @@
 //! decodes them; `serve` and `record` are the owners.
 //!
 //! - **Command socket**: bound on the interface that reaches the server (loopback for a
-//!   loopback server), only the server's datagrams taken. Connect, model definitions,
+//!   loopback server), only datagrams from the server's host taken. Connect, model definitions,
 //!   keep-alive and echo go out from here; in unicast, frames come back here too.
 //! - **Data socket**: a multicast group joined on the interface (bound to the group, port
 //!   shared with other clients on the host), or a local unicast address; from `natnet_data`,
@@ -18,8 +18,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use protocol::natnet::{
-    check_packet, decode_frame_into, Channel, Client, ClientConfig, ClockEstimate, Event,
-    FrameOfData, Incoming, MessageId, ModelDefs, NatNetVersion, ServerInfo,
+    check_packet, decode_frame_into, decode_packet, encode_request_into, response_code, Channel,
+    Client, ClientConfig, ClockEstimate, Event, FrameOfData, Incoming, MessageId, ModelDefs,
+    NatNetVersion, Packet, ServerInfo,
 };
 use socket2::{Domain, Protocol, Socket, Type};
 use tokio::net::UdpSocket;
@@ -43,6 +44,8 @@ pub struct Session {
     pub server: SocketAddr,
     /// Version, clock rate, timecode rate, markersets.
     pub layout: NatNetLayout,
+    /// The capture rate the server announced (its answer to `FrameRate`).
+    pub announced_rate_hz: Option<f64>,
     /// The session's local epoch and the server clock estimate against it.
     clock: Option<(Instant, ClockEstimate)>,
 }
@@ -70,6 +73,9 @@ pub struct Link {
     ids: LayoutIds,
     frame: FrameOfData,
     status: NatNetStatus,
+    /// `FrameRate` is to be asked (after a connect) / has been asked and not answered.
+    rate: (bool, bool),
+    announced_rate_hz: Option<f64>,
 }
 
 impl Link {
@@ -100,6 +106,8 @@ impl Link {
             ids: LayoutIds::default(),
             frame: FrameOfData::with_capacity(1_000, 16),
             status,
+            rate: (false, false),
+            announced_rate_hz: None,
             config,
         };
         if let Some(addr) = link.config.data {
@@ -138,7 +146,9 @@ impl Link {
                 () = shutdown.cancelled() => break,
                 r = self.command.recv_from(&mut buf) => {
                     if let Ok((n, from)) = r {
-                        if from == self.config.server {
+                        // Unicast frames come from the server's data port, not its
+                        // command port: any port of the server's host.
+                        if from.ip() == self.config.server.ip() {
                             self.datagram(Channel::Command, &buf[..n], on_frame);
                         }
                     }
@@ -158,13 +168,11 @@ impl Link {
     }
 
     /// One datagram from the server.
-    fn datagram(
-        &mut self,
-        channel: Channel,
-        bytes: &[u8],
-        on_frame: &mut FrameSink<'_>,
-    ) {
+    fn datagram(&mut self, channel: Channel, bytes: &[u8], on_frame: &mut FrameSink<'_>) {
         let now = Instant::now();
+        if channel == Channel::Command && self.rate.1 {
+            self.frame_rate_reply(bytes);
+        }
         let incoming = match self.client.handle_datagram(now, channel, bytes) {
             Ok(i) => i,
             Err(e) => {
@@ -187,11 +195,36 @@ impl Link {
         }
     }
 
-    /// Sends what the client wants sent.
+    /// Sends what the client wants sent, and the `FrameRate` question after a connect.
     async fn flush(&mut self) {
         while let Some(bytes) = self.client.poll_transmit() {
             // A lost request is retried by the client's timers.
             let _ = self.command.send_to(bytes, self.config.server).await;
+        }
+        if std::mem::take(&mut self.rate.0) {
+            let mut out = Vec::with_capacity(16);
+            if encode_request_into("FrameRate", &mut out).is_ok() {
+                let _ = self.command.send_to(&out, self.config.server).await;
+                self.rate.1 = true;
+            }
+        }
+    }
+
+    /// A 4-byte NAT_RESPONSE while `FrameRate` is unanswered: the rate, as an `f32`.
+    fn frame_rate_reply(&mut self, bytes: &[u8]) {
+        let Ok(Packet::Response(payload)) = decode_packet(bytes) else {
+            return;
+        };
+        let Some(code) = response_code(payload) else {
+            return;
+        };
+        let hz = f64::from(f32::from_bits(code as u32));
+        if hz.is_finite() && (1.0..=100_000.0).contains(&hz) {
+            self.rate.1 = false;
+            self.announced_rate_hz = Some(hz);
+            self.status.announced_rate_hz = Some(hz);
+            tracing::info!(target: "emoshift", rate_hz = hz, "natnet: the server's frame rate");
+            self.update_session(|s| s.announced_rate_hz = Some(hz));
         }
     }
 
@@ -224,6 +257,7 @@ impl Link {
     fn connected(&mut self, info: ServerInfo) -> Result<()> {
         self.status.connected = true;
         self.status.connects += 1;
+        self.rate = (true, false);
         self.status.server_name = format!(
             "{} {}, NatNet {}",
             info.app_name,
@@ -280,6 +314,7 @@ impl Link {
         self.session = Some(Arc::new(Session {
             server: self.config.server,
             layout,
+            announced_rate_hz: self.announced_rate_hz,
             clock,
         }));
     }

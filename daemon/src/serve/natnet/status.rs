@@ -30,6 +30,8 @@ pub struct NatNetStatus {
     pub clock_offset_us: Option<i64>,
     /// That echo's round trip.
     pub rtt: Option<Duration>,
+    /// The capture rate the server announced.
+    pub announced_rate_hz: Option<f64>,
 }
 
 impl NatNetStatus {
@@ -48,6 +50,12 @@ impl NatNetStatus {
             text("server_name", &self.server_name),
             text("data", &self.data),
             text("markersets", &self.markersets),
+            text(
+                "announced_rate_hz",
+                &self
+                    .announced_rate_hz
+                    .map_or(String::new(), |r| format!("{r:.3}")),
+            ),
             int("connects", self.connects),
             int("disconnects", self.disconnects),
             int("frames", self.frames),
