@@ -59,6 +59,47 @@ pub struct BenchArgs {
     pub poll_window_us: u64,
 }
 
+/// `emoshift record`.
+#[derive(Debug, Args)]
+pub struct RecordArgs {
+    /// Take OSC frames on this socket, IP:PORT (what `emoshift replay --to` or a stage bridge
+    /// sends to).
+    #[arg(long, value_name = "IP:PORT", conflicts_with = "natnet")]
+    pub listen: Option<String>,
+    /// Take frames from a NatNet server (OptiTrack Motive): its command channel, IP[:PORT].
+    #[arg(long, value_name = "SERVER[:PORT]")]
+    pub natnet: Option<String>,
+    /// Where NatNet frames arrive: a multicast group or a local unicast address [default:
+    /// what the server announces].
+    #[arg(long, value_name = "ADDR:PORT", requires = "natnet")]
+    pub natnet_data: Option<String>,
+    /// Local IPv4 address to join the NatNet multicast group on.
+    #[arg(long, value_name = "IP", requires = "natnet")]
+    pub natnet_interface: Option<String>,
+    /// Rate of Motive's timecode (24, 25, 29.97df, 30, 59.94df...).
+    #[arg(long, value_name = "RATE", requires = "natnet")]
+    pub natnet_timecode_rate: Option<String>,
+    /// Marker names: asset:marker (as Motive exports them), asset_marker, or marker.
+    #[arg(long, value_name = "STYLE", requires = "natnet")]
+    pub natnet_names: Option<String>,
+    /// The file, .c3d, .trc or .csv.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Replace --out if it exists.
+    #[arg(long)]
+    pub force: bool,
+    /// Stop after this many frames (gaps included).
+    #[arg(long, value_name = "N", conflicts_with = "seconds")]
+    pub frames: Option<u64>,
+    /// Stop after this many seconds of capture.
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// The stream to record: a NatNet markerset (asset) name, or `IP:PORT/LAYOUT` of an OSC
+    /// source [default: the first stream that arrives].
+    #[arg(long, value_name = "NAME")]
+    pub performer: Option<String>,
+}
+
 /// `emoshift replay`.
 #[derive(Debug, Args)]
 pub struct ReplayArgs {

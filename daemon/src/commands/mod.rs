@@ -8,6 +8,7 @@ mod edit;
 mod info;
 mod inspect;
 mod project;
+mod record;
 mod replay;
 mod serve;
 mod synth;
@@ -55,6 +56,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Serve(args) => serve::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Replay(args) => replay::run(&args),
+        Command::Record(args) => record::run(&args),
         Command::Demo(args) => demo::run(&args),
     }
 }

@@ -76,7 +76,7 @@ pub(crate) fn run(args: &ServeArgs) -> Result<()> {
 }
 
 /// Cancels `token` on Ctrl-C or SIGTERM.
-async fn cancel_on_signal(token: CancellationToken) {
+pub(crate) async fn cancel_on_signal(token: CancellationToken) {
     #[cfg(unix)]
     {
         use tokio::signal::unix::{signal, SignalKind};

@@ -294,3 +294,102 @@ async fn unicast_frames_come_to_the_client_that_connected() {
     d.stop(Duration::from_secs(2)).await.expect("stops");
     server.stop();
 }
+
+/// `emoshift record --natnet`: the markerset's frames land in a C3D with the first frame's
+/// drop-frame timecode and the server's announced rate, complete after Ctrl-C (SIGINT).
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn record_from_natnet_is_complete_after_ctrl_c_with_its_timecode() {
+    use std::process::{Command, Stdio};
+    let m = model_file(34);
+    let group: SocketAddr = format!("239.255.42.99:{}", free_port())
+        .parse()
+        .expect("addr");
+    let mut server = motive(&m, "127.0.0.1:0".parse().expect("addr"), Some(group));
+    let out = m.dir.path().join("face.c3d");
+    let child = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"))
+        .args(["record", "--natnet", &server.command_addr().to_string()])
+        .args([
+            "--natnet-names",
+            "marker",
+            "--natnet-timecode-rate",
+            "29.97df",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("the binary starts");
+    for _ in 0..100 {
+        if server.clients() > 0 {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    // Time for the model definitions and the frame rate to come back.
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    stream(&m, &mut server, 0..120).await;
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(kill.success());
+    let done = tokio::task::spawn_blocking(move || child.wait_with_output())
+        .await
+        .expect("join")
+        .expect("the child ends");
+    assert!(done.status.success(), "{:?}", done.status);
+    let printed = String::from_utf8_lossy(&done.stdout).to_string();
+    assert!(printed.contains("120 frames of Face"), "{printed}");
+    assert!(printed.contains("announced 120"), "{printed}");
+    let take = replay::load(&out).expect("a complete C3D");
+    assert_eq!((take.n_frames(), take.rate_hz), (120, 120.0));
+    assert_eq!(take.labels, m.model.labels());
+    let (metres, tc) = frame(&m, 0);
+    let back = replay::c3d::read_time(&std::fs::read(&out).expect("read")).expect("params");
+    assert_eq!(back.timecode, Some(tc));
+    let want: Vec<f32> = metres.iter().flatten().map(|v| v * 1000.0).collect();
+    assert_eq!(take.frame(0), want.as_slice());
+    server.stop();
+}
+
+/// `emoshift record --listen` stops by itself after `--frames`, says so when nothing arrives,
+/// and writes the OSC source's timecode into a CSV column.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn record_from_osc_stops_after_its_frames_and_says_when_nothing_arrives() {
+    use std::process::{Command, Stdio};
+    let m = model_file(35);
+    let port = free_port();
+    let out = m.dir.path().join("take.csv");
+    let child = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"))
+        .args(["record", "--listen", &format!("127.0.0.1:{port}")])
+        .args(["--frames", "48", "--out"])
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary starts");
+    // Silence first: the quiet line comes after 3 s.
+    tokio::time::sleep(Duration::from_millis(3_400)).await;
+    let to: SocketAddr = format!("127.0.0.1:{port}").parse().expect("addr");
+    send_osc(&m, to, 0..60).await;
+    let done = tokio::task::spawn_blocking(move || child.wait_with_output())
+        .await
+        .expect("join")
+        .expect("the child ends by itself after 48 frames");
+    assert!(done.status.success());
+    let err = String::from_utf8_lossy(&done.stderr);
+    assert!(err.contains("nothing has arrived on"), "{err}");
+    let text = std::fs::read_to_string(&out).expect("written");
+    let rows: Vec<&str> = text.lines().skip(2).collect();
+    assert_eq!(rows.len(), 48);
+    assert!(text
+        .lines()
+        .nth(1)
+        .expect("header")
+        .starts_with("frame,time,timecode,"));
+    let (_, tc) = frame(&m, 40);
+    assert_eq!(rows[40].split(',').nth(2), Some(tc.to_string().as_str()));
+    assert_eq!(replay::load(&out).expect("loads").n_frames(), 48);
+}
