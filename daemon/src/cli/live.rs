@@ -40,6 +40,10 @@ pub struct ServeArgs {
     /// Rate of Motive's timecode, which NatNet does not send (24, 25, 29.97df, 30, 59.94df...).
     #[arg(long, value_name = "RATE", requires = "natnet")]
     pub natnet_timecode_rate: Option<String>,
+    /// NatNet marker names: asset:marker (as Motive exports them; default), asset_marker, or
+    /// marker.
+    #[arg(long, value_name = "STYLE", requires = "natnet")]
+    pub natnet_names: Option<String>,
 }
 
 /// `emoshift bench`.
@@ -57,6 +61,11 @@ pub struct BenchArgs {
     /// The daemon's `poll_window_us` (0: the processing thread always parks).
     #[arg(long, default_value_t = crate::serve::config::DEFAULT_POLL_WINDOW_US)]
     pub poll_window_us: u64,
+    /// Also feed the daemon from a NatNet server (a Motive stand-in on loopback, multicast),
+    /// in rounds alternating with the OSC source and the relay: frames lost over NatNet, and
+    /// its added latency against OSC's in the same run.
+    #[arg(long)]
+    pub natnet: bool,
 }
 
 /// `emoshift record`.

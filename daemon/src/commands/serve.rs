@@ -43,6 +43,7 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
         (&args.natnet_data, &mut raw.natnet_data),
         (&args.natnet_interface, &mut raw.natnet_interface),
         (&args.natnet_timecode_rate, &mut raw.natnet_timecode_rate),
+        (&args.natnet_names, &mut raw.natnet_names),
     ] {
         if let Some(v) = flag {
             *key = Some(v.clone());

@@ -11,6 +11,9 @@
 //!   markers include markers of the markerset's model (the rigid body, skeleton or asset of the
 //!   same name, ids `model << 16 | index`), a marker absent from them or flagged occluded is
 //!   missing; otherwise a marker at exactly (0, 0, 0), or NaN, is.
+//! - **Asset markers off.** A frame without the markerset (Motive's *Asset Markers* streaming
+//!   off) takes the asset's markers from its labelled markers (model id, 1-based index), in
+//!   the order of the markerset description.
 //! - **Motive's `all` markerset** repeats every labelled marker of the other assets: skipped.
 //! - **Time.** The capture time is the mid-exposure stamp in µs of the server's clock (its
 //!   timestamp when the cameras give none); the timecode is the frame's, at the configured
@@ -226,47 +229,88 @@ impl NatNetFrames {
     }
 
     /// Markerset `set` of the layout, from the decoded frame, into `out` (mm, missing markers
-    /// NaN). `None` when the frame does not carry it, or carries another number of markers
-    /// than its description.
+    /// NaN). When the frame carries no such markerset (Motive's *Asset Markers* streaming off)
+    /// its markers come from the asset's labelled markers instead. `None` when the frame has
+    /// neither, or carries another number of markers than the description.
     pub fn markerset_into(
         &mut self,
         set: &MarkersetLayout,
         layout: &NatNetLayout,
         out: &mut FrameBuf,
     ) -> Option<FrameHeader> {
-        let positions = self.frame.markerset_named(&set.name)?.positions;
-        if positions.len() != set.labels.len() {
-            return None;
-        }
-        self.seen.clear();
-        self.seen.resize(positions.len(), false);
-        let judged = set.model_id.is_some_and(|model| {
-            let mut any = false;
-            for m in &self.frame.labeled_markers {
-                let i = usize::from(m.marker_index());
-                if m.model_id() == model && (1..=positions.len()).contains(&i) {
-                    any = true;
-                    self.seen[i - 1] = !m.params.occluded();
-                }
-            }
-            any
-        });
+        let n = set.labels.len();
         self.xyz.clear();
-        for (p, &seen) in positions.iter().zip(&self.seen) {
-            let gone = if judged {
-                !seen
-            } else {
-                *p == [0.0; 3] || p.iter().any(|v| v.is_nan())
-            };
-            match gone {
-                true => self.xyz.extend_from_slice(&[f32::NAN; 3]),
-                false => self.xyz.extend(p.iter().map(|v| v * MM_PER_M)),
+        let carried = match self.frame.markerset_named(&set.name) {
+            Some(ms) if ms.positions.len() == n => {
+                self.seen.clear();
+                self.seen.resize(n, false);
+                let judged = set
+                    .model_id
+                    .is_some_and(|model| mark_seen(&self.frame, model, &mut self.seen));
+                for (p, &seen) in ms.positions.iter().zip(&self.seen) {
+                    let gone = if judged {
+                        !seen
+                    } else {
+                        *p == [0.0; 3] || p.iter().any(|v| v.is_nan())
+                    };
+                    push_mm(&mut self.xyz, (!gone).then_some(p));
+                }
+                true
             }
+            Some(_) => false,
+            None => set
+                .model_id
+                .is_some_and(|model| labelled_into(&self.frame, model, n, &mut self.xyz)),
+        };
+        if !carried {
+            return None;
         }
         let capture = self.capture_time_us(layout);
         out.set_frame(self.frame.frame_number, capture, &self.xyz)
             .ok()?;
         Some(out.header())
+    }
+}
+
+/// Marks the markers of `model` seen in `frame`'s labelled markers (present, not occluded);
+/// `true` when any of its labelled markers is there at all.
+fn mark_seen(frame: &FrameOfData, model: u16, seen: &mut [bool]) -> bool {
+    let mut any = false;
+    for m in &frame.labeled_markers {
+        let i = usize::from(m.marker_index());
+        if m.model_id() == model && (1..=seen.len()).contains(&i) {
+            any = true;
+            seen[i - 1] = !m.params.occluded();
+        }
+    }
+    any
+}
+
+/// The `n` markers of `model` from `frame`'s labelled markers (1-based index order), in mm
+/// into `xyz` (missing: absent or occluded); `false` when none of them is there.
+fn labelled_into(frame: &FrameOfData, model: u16, n: usize, xyz: &mut Vec<f32>) -> bool {
+    xyz.clear();
+    xyz.resize(n * 3, f32::NAN);
+    let mut any = false;
+    for m in &frame.labeled_markers {
+        let i = usize::from(m.marker_index());
+        if m.model_id() == model && (1..=n).contains(&i) {
+            any = true;
+            if !m.params.occluded() && m.position.iter().all(|v| v.is_finite()) {
+                for (d, v) in xyz[3 * (i - 1)..3 * i].iter_mut().zip(m.position) {
+                    *d = v * MM_PER_M;
+                }
+            }
+        }
+    }
+    any
+}
+
+/// Appends one marker in mm, or NaN for a missing one.
+fn push_mm(xyz: &mut Vec<f32>, p: Option<&[f32; 3]>) {
+    match p {
+        Some(p) => xyz.extend(p.iter().map(|v| v * MM_PER_M)),
+        None => xyz.extend_from_slice(&[f32::NAN; 3]),
     }
 }
 

@@ -169,3 +169,38 @@ fn each_markerset_is_a_stream_even_when_two_have_the_same_size() {
     p.handle_natnet(server, &[7, 0, 1, 0, 0], &l, &mut |_| {});
     assert_eq!(p.counters.bad_natnet, 1);
 }
+
+/// Motive with *Asset Markers* off (as in the real 2.1 capture) streams no markersets: the
+/// asset's markers come from its labelled markers, occluded ones missing.
+#[test]
+fn without_asset_markers_the_labelled_markers_make_the_frame() {
+    let defs =
+        decode_model_defs(&fixture("modeldef_packet_v3.bin"), NatNetVersion::V3_0).expect("valid");
+    let l = layout(&defs, &Naming::default());
+    let mut f = FrameOfData::default();
+    f.frame_number = 9;
+    for (i, occluded) in [(1u32, false), (2, true), (4, false), (9, false)] {
+        f.labeled_markers.push(LabeledMarker {
+            id: 2 << 16 | i,
+            position: [0.1 * i as f32, 1.0, -0.5],
+            params: MarkerParams(u16::from(occluded)),
+            ..LabeledMarker::default()
+        });
+    }
+    let mut bytes = Vec::new();
+    encode_frame_into(&f, NatNetVersion::V3_0, &mut bytes).expect("encodable");
+    let mut frames = NatNetFrames::new(8);
+    frames.decode(&bytes, &l).expect("valid");
+    let mut out = FrameBuf::with_max_markers(8);
+    let h = frames
+        .markerset_into(&l.markersets[0], &l, &mut out)
+        .expect("RaceQuad's labelled markers are there");
+    assert_eq!(
+        (h.marker_count, h.missing_count),
+        (5, 3),
+        "2 occluded, 3 and 5 absent"
+    );
+    assert_eq!(&out.positions()[..3], &[100.0, 1000.0, -500.0]);
+    let x4 = 0.1 * 4.0_f32 * 1000.0;
+    assert_eq!(&out.positions()[9..12], &[x4, 1000.0, -500.0]);
+}

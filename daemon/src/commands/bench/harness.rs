@@ -134,9 +134,9 @@ pub(super) async fn through_relay(
     Ok(collect(receivers).await)
 }
 
-type Receivers = Vec<Collecting<Seen>>;
+pub(super) type Receivers = Vec<Collecting<Seen>>;
 
-async fn receivers(k: usize) -> Result<(Receivers, Vec<SocketAddr>)> {
+pub(super) async fn receivers(k: usize) -> Result<(Receivers, Vec<SocketAddr>)> {
     let mut out = Vec::with_capacity(k);
     let mut addrs = Vec::with_capacity(k);
     for _ in 0..k {
@@ -159,7 +159,7 @@ fn time_frame(seen: &mut Seen, r: &Received<'_>) {
     }
 }
 
-async fn collect(receivers: Receivers) -> Seen {
+pub(super) async fn collect(receivers: Receivers) -> Seen {
     let mut all = Seen::new();
     for r in receivers {
         if let Ok(s) = r.stop().await {
@@ -170,7 +170,7 @@ async fn collect(receivers: Receivers) -> Seen {
 }
 
 /// The bench's clock, shared by senders and receivers.
-fn epoch() -> Instant {
+pub(super) fn epoch() -> Instant {
     static EPOCH: OnceLock<Instant> = OnceLock::new();
     *EPOCH.get_or_init(Instant::now)
 }

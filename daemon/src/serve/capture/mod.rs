@@ -205,7 +205,8 @@ async fn natnet(
     let started = Instant::now();
     let mut on_frame = |bytes: &[u8], received: Instant, session: &Arc<Session>| {
         let layout = &session.layout;
-        if frames.decode(bytes, layout).is_err() {
+        if let Err(e) = frames.decode(bytes, layout) {
+            tracing::debug!(target: "emoshift", error = %e, "record: a NatNet frame did not decode");
             return;
         }
         let time = frames.time(layout);

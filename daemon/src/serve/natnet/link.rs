@@ -184,6 +184,8 @@ impl Link {
         let is_frame = incoming == Incoming::Frame
             || (incoming == Incoming::Ignored && check_packet(bytes) == Ok(MessageId::FrameOfData));
         let Some(session) = self.session.as_ref().filter(|_| is_frame) else {
+            tracing::trace!(target: "emoshift", ?incoming, session = self.session.is_some(),
+                "natnet: datagram not handed on");
             return;
         };
         self.status.frames += 1;
