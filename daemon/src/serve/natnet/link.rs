@@ -120,7 +120,7 @@ impl Link {
     /// time and session; `on_status` hears every change and once a second.
     ///
     /// # Errors
-    /// A data socket that cannot be bound or joined after a server info.
+    /// None yet: a data socket that cannot be opened is logged and shown in the status.
     pub async fn run(
         mut self,
         shutdown: CancellationToken,
@@ -131,9 +131,12 @@ impl Link {
         let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
         let mut data_buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
         let mut next_status = Instant::now();
+        // One timer, moved only when the deadline moves: a frame's wake-up registers nothing.
+        let timer = tokio::time::sleep_until(next_status.into());
+        tokio::pin!(timer);
         loop {
             self.flush().await;
-            if self.drain_events()? || Instant::now() >= next_status {
+            if self.drain_events() || Instant::now() >= next_status {
                 on_status(&self.status);
                 next_status = Instant::now() + STATUS_EVERY;
             }
@@ -141,7 +144,12 @@ impl Link {
                 .client
                 .poll_timeout()
                 .unwrap_or_else(|| Instant::now() + STATUS_EVERY)
-                .min(next_status);
+                .min(next_status)
+                // A deadline already past fires in a millisecond, never in a spin.
+                .max(Instant::now() + Duration::from_millis(1));
+            if timer.deadline() != deadline.into() {
+                timer.as_mut().reset(deadline.into());
+            }
             tokio::select! {
                 () = shutdown.cancelled() => break,
                 r = self.command.recv_from(&mut buf) => {
@@ -158,7 +166,7 @@ impl Link {
                         self.datagram(Channel::Data, &data_buf[..n], on_frame);
                     }
                 }
-                () = tokio::time::sleep_until(deadline.into()) => {
+                () = &mut timer => {
                     self.client.handle_timeout(Instant::now());
                 }
             }
@@ -231,12 +239,12 @@ impl Link {
     }
 
     /// Applies the client's events; `true` when the status changed.
-    fn drain_events(&mut self) -> Result<bool> {
+    fn drain_events(&mut self) -> bool {
         let mut changed = false;
         while let Some(event) = self.client.poll_event() {
             changed = true;
             match event {
-                Event::Connected(info) => self.connected(info)?,
+                Event::Connected(info) => self.connected(info),
                 Event::ModelDefs(defs) => self.model_defs(&defs),
                 Event::Disconnected(reason) => {
                     self.status.connected = false;
@@ -253,10 +261,10 @@ impl Link {
                 Event::VersionChanged(v) => self.update_session(|s| s.layout.version = v),
             }
         }
-        Ok(changed)
+        changed
     }
 
-    fn connected(&mut self, info: ServerInfo) -> Result<()> {
+    fn connected(&mut self, info: ServerInfo) {
         self.status.connected = true;
         self.status.connects += 1;
         self.rate = (true, false);
@@ -270,19 +278,27 @@ impl Link {
             c.multicast
                 .then(|| SocketAddr::from((Ipv4Addr::from(c.multicast_group), c.data_port)))
         });
-        if let Some(addr) = self.config.data.or(announced) {
-            if self.data.as_ref().map(|d| d.0) != Some(addr) {
-                self.bind_data(addr)?;
-            }
-        }
         self.status.data = match &self.data {
             Some((a, _)) => a.to_string(),
             None => "the command socket (unicast)".into(),
         };
+        if let Some(addr) = self.config.data.or(announced) {
+            if self.data.as_ref().map(|d| d.0) != Some(addr) {
+                // Logged and shown, not fatal: the next server info tries again, and OSC
+                // sources go on meanwhile.
+                self.status.data = match self.bind_data(addr) {
+                    Ok(()) => addr.to_string(),
+                    Err(e) => {
+                        tracing::error!(target: "emoshift", error = %format!("{e:#}"),
+                            "natnet: no data socket");
+                        format!("{addr} (cannot be opened: {e})")
+                    }
+                };
+            }
+        }
         tracing::info!(target: "emoshift", server = %self.config.server,
             name = %self.status.server_name, data = %self.status.data, "natnet: connected");
         self.info = Some(info);
-        Ok(())
     }
 
     fn model_defs(&mut self, defs: &ModelDefs) {
