@@ -26,10 +26,18 @@ pub struct ServeArgs {
     /// Low-pass window of the emotion edit, seconds [default: 1].
     #[arg(long)]
     pub lowpass: Option<f32>,
-    /// Take frames from an OptiTrack Motive NatNet server: its command channel, IP[:PORT]
-    /// [port 1510]. Each markerset becomes a stream, beside the OSC frame socket.
+    /// Take frames from an OptiTrack Motive NatNet server too: its command channel,
+    /// IP[:PORT] [port 1510]. Each markerset becomes a stream, beside the OSC frame socket.
     #[arg(long, value_name = "SERVER[:PORT]")]
     pub natnet: Option<String>,
+    /// The NatNet source's settings.
+    #[command(flatten)]
+    pub natnet_options: NatNetArgs,
+}
+
+/// The NatNet options `serve` and `record` share (each needs `--natnet`).
+#[derive(Debug, Args)]
+pub struct NatNetArgs {
     /// Where NatNet frames arrive: a multicast group (joined on --natnet-interface) or a
     /// local unicast address [default: what the server announces].
     #[arg(long, value_name = "ADDR:PORT", requires = "natnet")]
@@ -44,6 +52,20 @@ pub struct ServeArgs {
     /// marker.
     #[arg(long, value_name = "STYLE", requires = "natnet")]
     pub natnet_names: Option<String>,
+}
+
+impl NatNetArgs {
+    /// These options over the `natnet` keys of a config.
+    pub fn raw(&self, server: Option<String>) -> crate::serve::natnet::RawNatNet {
+        crate::serve::natnet::RawNatNet {
+            server,
+            data: self.natnet_data.clone(),
+            interface: self.natnet_interface.clone(),
+            timecode_rate: self.natnet_timecode_rate.clone(),
+            names: self.natnet_names.clone(),
+            ..Default::default()
+        }
+    }
 }
 
 /// `emoshift bench`.
@@ -78,19 +100,9 @@ pub struct RecordArgs {
     /// Take frames from a NatNet server (OptiTrack Motive): its command channel, IP[:PORT].
     #[arg(long, value_name = "SERVER[:PORT]")]
     pub natnet: Option<String>,
-    /// Where NatNet frames arrive: a multicast group or a local unicast address [default:
-    /// what the server announces].
-    #[arg(long, value_name = "ADDR:PORT", requires = "natnet")]
-    pub natnet_data: Option<String>,
-    /// Local IPv4 address to join the NatNet multicast group on.
-    #[arg(long, value_name = "IP", requires = "natnet")]
-    pub natnet_interface: Option<String>,
-    /// Rate of Motive's timecode (24, 25, 29.97df, 30, 59.94df...).
-    #[arg(long, value_name = "RATE", requires = "natnet")]
-    pub natnet_timecode_rate: Option<String>,
-    /// Marker names: asset:marker (as Motive exports them), asset_marker, or marker.
-    #[arg(long, value_name = "STYLE", requires = "natnet")]
-    pub natnet_names: Option<String>,
+    /// The NatNet source's settings.
+    #[command(flatten)]
+    pub natnet_options: NatNetArgs,
     /// The file, .c3d, .trc or .csv.
     #[arg(long)]
     pub out: PathBuf,

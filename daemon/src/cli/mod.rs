@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 mod live;
 mod offline;
 
-pub use live::{BenchArgs, DemoArgs, RecordArgs, ReplayArgs, ServeArgs, WireFormat};
+pub use live::{BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, WireFormat};
 pub use offline::{
     AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InspectArgs, KeyValue, ProjectArgs, SynthArgs,
     TrainArgs,

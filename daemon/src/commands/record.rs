@@ -7,7 +7,6 @@ use tokio_util::sync::CancellationToken;
 use crate::cli::RecordArgs;
 use crate::exit::UsageError;
 use crate::serve::capture::{self, CaptureConfig, Source};
-use crate::serve::natnet::RawNatNet;
 
 /// The arguments, checked.
 fn config(args: &RecordArgs) -> Result<CaptureConfig> {
@@ -17,14 +16,7 @@ fn config(args: &RecordArgs) -> Result<CaptureConfig> {
                 .map_err(|_| UsageError(format!("--listen: {l:?} is not an IP:PORT address")))?,
         ),
         (None, Some(server)) => {
-            let raw = RawNatNet {
-                server: Some(server.clone()),
-                data: args.natnet_data.clone(),
-                interface: args.natnet_interface.clone(),
-                timecode_rate: args.natnet_timecode_rate.clone(),
-                names: args.natnet_names.clone(),
-                ..RawNatNet::default()
-            };
+            let raw = args.natnet_options.raw(Some(server.clone()));
             let n = raw.validate().map_err(|e| UsageError(e.to_string()))?;
             Source::NatNet(n.expect("a server was given"))
         }

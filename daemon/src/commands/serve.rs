@@ -38,15 +38,16 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if let Some(l) = args.lowpass {
         raw.lowpass_s = Some(l);
     }
+    let flags = args.natnet_options.raw(args.natnet.clone());
     for (flag, key) in [
-        (&args.natnet, &mut raw.natnet),
-        (&args.natnet_data, &mut raw.natnet_data),
-        (&args.natnet_interface, &mut raw.natnet_interface),
-        (&args.natnet_timecode_rate, &mut raw.natnet_timecode_rate),
-        (&args.natnet_names, &mut raw.natnet_names),
+        (flags.server, &mut raw.natnet),
+        (flags.data, &mut raw.natnet_data),
+        (flags.interface, &mut raw.natnet_interface),
+        (flags.timecode_rate, &mut raw.natnet_timecode_rate),
+        (flags.names, &mut raw.natnet_names),
     ] {
-        if let Some(v) = flag {
-            *key = Some(v.clone());
+        if flag.is_some() {
+            *key = flag;
         }
     }
     raw.validate().map_err(|e| UsageError(e.to_string()).into())

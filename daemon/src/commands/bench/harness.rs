@@ -71,16 +71,7 @@ pub(super) async fn through_daemon(
     poll_window_us: u64,
 ) -> Result<Run> {
     let (receivers, addrs) = receivers(clients).await?;
-    let mut raw = RawConfig {
-        listen: Some("127.0.0.1:0".into()),
-        control: Some("127.0.0.1:0".into()),
-        model: Some("unused".into()),
-        queue: Some(1024),
-        poll_window_us: Some(poll_window_us),
-        stats_interval_s: Some(3600.0),
-        ..RawConfig::default()
-    };
-    raw.send = addrs.iter().map(|a| a.to_string()).collect();
+    let raw = daemon_config(&addrs, poll_window_us);
     let daemon = Daemon::start_with(raw.validate()?, model.clone()).await?;
     let traffic = async {
         let sent = send_all(model, performers, daemon.frames, rate_hz, secs).await?;
@@ -97,6 +88,20 @@ pub(super) async fn through_daemon(
         sent,
         status,
     })
+}
+
+/// The bench daemon's config: loopback, sending to `receivers`, a long queue, quiet logs.
+pub(super) fn daemon_config(receivers: &[SocketAddr], poll_window_us: u64) -> RawConfig {
+    RawConfig {
+        listen: Some("127.0.0.1:0".into()),
+        control: Some("127.0.0.1:0".into()),
+        model: Some("unused".into()),
+        queue: Some(1024),
+        poll_window_us: Some(poll_window_us),
+        stats_interval_s: Some(3600.0),
+        send: receivers.iter().map(|a| a.to_string()).collect(),
+        ..RawConfig::default()
+    }
 }
 
 /// The same traffic through a minimal relay: one thread, blocking receive, the same bytes

@@ -13,7 +13,7 @@ use ica_core::model::IcaModel;
 use protocol::natnet::{FrameOfData, MarkersetDef, ModelDefs, NatNetVersion};
 use replay::pacer::{Pacer, PacerOptions};
 
-use super::harness::{collect, epoch, receivers, Run};
+use super::harness::{collect, daemon_config, epoch, receivers, Run};
 use super::MARKERS;
 use crate::loopback::motive::{Motive, MotiveOptions};
 use crate::loopback::source::{drive, Due};
@@ -55,18 +55,11 @@ pub(super) async fn through_daemon_natnet(
         epoch: epoch(),
         rate_hz: 120.0,
     })?;
-    let mut raw = RawConfig {
-        listen: Some("127.0.0.1:0".into()),
-        control: Some("127.0.0.1:0".into()),
-        model: Some("unused".into()),
-        queue: Some(1024),
-        poll_window_us: Some(poll_window_us),
-        stats_interval_s: Some(3600.0),
+    let raw = RawConfig {
         natnet: Some(server.command_addr().to_string()),
         natnet_names: Some("marker".into()),
-        ..RawConfig::default()
+        ..daemon_config(&addrs, poll_window_us)
     };
-    raw.send = addrs.iter().map(|a| a.to_string()).collect();
     let daemon = Daemon::start_with(raw.validate()?, model.clone()).await?;
     let traffic = async {
         let control = ControlClient::new(daemon.control).await?;

@@ -26,9 +26,7 @@ mod setup;
 
 use encode::Outputs;
 pub use encode::{profile_bit, ProfileMask};
-use run::{run_stream, stream_for, Io};
 pub use setup::apply_edit;
-use setup::Defaults;
 
 /// A source's datagram refused with a reason it should hear (`/emoshift/error` on the frame
 /// socket); the shell sends it, rate-limited.
@@ -335,32 +333,7 @@ impl Pipeline {
             source: peer,
             layout_id: labels.layout_id,
         };
-        let defaults = Defaults {
-            performers: &self.performers,
-            model: &self.model,
-            template: &self.template,
-            lowpass_s: self.config.lowpass_s,
-        };
-        let counters = &mut self.counters;
-        let Some(stream) = stream_for(
-            &mut self.streams,
-            key,
-            &labels.names,
-            None,
-            &defaults,
-            counters,
-        ) else {
-            return;
-        };
-        let io = Io {
-            frame_in: &self.frame_in,
-            frame_out: &mut self.frame_out,
-            outputs: &mut self.outputs,
-            wanted: self.wanted,
-            time: &self.time_in,
-            counters,
-        };
-        run_stream(stream, key, &header, io, emit);
+        run::frame_step(run::step!(self), key, (&labels.names, None), &header, emit);
     }
 }
 

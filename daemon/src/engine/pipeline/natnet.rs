@@ -6,8 +6,6 @@ use core::net::SocketAddr;
 use crate::engine::natnet::{NatNetFrames, NatNetLayout};
 use crate::engine::streams::StreamKey;
 
-use super::run::{run_stream, stream_for, Io};
-use super::setup::Defaults;
 use super::{Emitted, Pipeline};
 
 /// The pipeline's NatNet buffers.
@@ -63,32 +61,8 @@ impl Pipeline {
                 // New model definitions renamed this markerset's markers: start it over.
                 self.streams.forget(server, set.layout_id);
             }
-            let defaults = Defaults {
-                performers: &self.performers,
-                model: &self.model,
-                template: &self.template,
-                lowpass_s: self.config.lowpass_s,
-            };
-            let counters = &mut self.counters;
-            let Some(stream) = stream_for(
-                &mut self.streams,
-                key,
-                &set.labels,
-                Some(&set.name),
-                &defaults,
-                counters,
-            ) else {
-                continue;
-            };
-            let io = Io {
-                frame_in: &self.frame_in,
-                frame_out: &mut self.frame_out,
-                outputs: &mut self.outputs,
-                wanted: self.wanted,
-                time: &self.time_in,
-                counters,
-            };
-            run_stream(stream, key, &header, io, emit);
+            let source = (set.labels.as_slice(), Some(set.name.as_str()));
+            super::run::frame_step(super::run::step!(self), key, source, &header, emit);
         }
     }
 }

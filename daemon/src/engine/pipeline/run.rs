@@ -31,6 +31,57 @@ pub(super) fn stream_for<'s>(
     stream
 }
 
+/// What steps 4 to 7 borrow from the pipeline, built by `step!` field by field (the caller
+/// may hold the labels borrowed from another field).
+pub(super) struct Step<'a> {
+    pub(super) streams: &'a mut Streams,
+    pub(super) defaults: Defaults<'a>,
+    pub(super) io: Io<'a>,
+}
+
+/// Borrows a [`Step`] from the pipeline `$p`'s fields.
+macro_rules! step {
+    ($p:expr) => {
+        $crate::engine::pipeline::run::Step {
+            streams: &mut $p.streams,
+            defaults: $crate::engine::pipeline::setup::Defaults {
+                performers: &$p.performers,
+                model: &$p.model,
+                template: &$p.template,
+                lowpass_s: $p.config.lowpass_s,
+            },
+            io: $crate::engine::pipeline::run::Io {
+                frame_in: &$p.frame_in,
+                frame_out: &mut $p.frame_out,
+                outputs: &mut $p.outputs,
+                wanted: $p.wanted,
+                time: &$p.time_in,
+                counters: &mut $p.counters,
+            },
+        }
+    };
+}
+pub(super) use step;
+
+/// Steps 4 to 7 of a frame whose source's labels are known: its stream (made on its first
+/// frame), then [`run_stream`].
+pub(super) fn frame_step(
+    s: Step<'_>,
+    key: StreamKey,
+    (labels, name): (&[String], Option<&str>),
+    header: &FrameHeader,
+    emit: &mut dyn FnMut(&Emitted<'_>),
+) {
+    let Step {
+        streams,
+        defaults,
+        io,
+    } = s;
+    if let Some(stream) = stream_for(streams, key, labels, name, &defaults, io.counters) {
+        run_stream(stream, key, header, io, emit);
+    }
+}
+
 /// The buffers a frame goes through, borrowed from the pipeline.
 pub(super) struct Io<'a> {
     /// The frame as received, in source order.
