@@ -8,9 +8,10 @@
 //!    where frames went (from `/status`).
 //! 3. One processing thread: frames through [`Pipeline`] back to back (109 markers, m = 20).
 //!
-//! With `--natnet`, a third source joins the paced rounds: the same performers as markersets
-//! of a Motive stand-in's NatNet stream ([`natnet`]), and the report compares it with the OSC
-//! source measured in the same run.
+//! With `--natnet`, NatNet sources join the paced rounds: the same performers as markersets
+//! of a Motive stand-in's NatNet stream ([`natnet`]), multicast (Motive's default; the kernel's
+//! multicast loopback is part of the path) and unicast, each compared with the OSC source
+//! measured in the same run.
 //!
 //! Bounded in time, only 127.0.0.1.
 
@@ -57,12 +58,16 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         let w = args.poll_window_us;
         let mut daemon = through_daemon(&model, n, k, 120.0, per_round, w).await?;
         let mut relay = through_relay(&model, n, k, per_round).await?;
-        let mut over_natnet = None;
+        let mut over_natnet: [Option<Run>; 2] = [None, None];
         for round in 0..rounds {
-            if args.natnet {
-                let r = natnet::through_daemon_natnet(&model, n, k, per_round, w).await?;
-                match over_natnet.as_mut() {
-                    None => over_natnet = Some(r),
+            for (multicast, all) in [true, false].into_iter().zip(over_natnet.iter_mut()) {
+                if !args.natnet {
+                    break;
+                }
+                let r =
+                    natnet::through_daemon_natnet(&model, (n, k), per_round, w, multicast).await?;
+                match all.as_mut() {
+                    None => *all = Some(r),
                     Some(all) => Run::add(all, r),
                 }
             }
@@ -105,8 +110,10 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
             d as f64 / r.max(1) as f64
         );
     }
-    if let Some(nn) = &over_natnet {
-        print_natnet(nn, &daemon, &relay, k)?;
+    for (nn, how) in over_natnet.iter().zip(["multicast", "unicast"]) {
+        if let Some(nn) = nn {
+            print_natnet(nn, how, (&daemon, &relay), k)?;
+        }
     }
     print_max_rate(&max)?;
     let (per_frame_us, fps) = processing_rate(&model)?;
@@ -117,10 +124,15 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
 }
 
 /// The NatNet rounds: loss, and added latency against the OSC rounds and the relay.
-fn print_natnet(nn: &Run, osc: &Run, relay: &harness::Seen, clients: usize) -> Result<()> {
+fn print_natnet(
+    nn: &Run,
+    how: &str,
+    (osc, relay): (&Run, &harness::Seen),
+    clients: usize,
+) -> Result<()> {
     let expected = nn.sent * clients as u64;
     crate::out!(
-        "natnet (Motive stand-in, multicast on loopback): {} of {expected} datagrams received, \
+        "natnet (Motive stand-in, {how} on loopback): {} of {expected} datagrams received, \
          {} lost; bad natnet datagrams (last round) {}",
         nn.seen.received,
         expected.saturating_sub(nn.seen.received),
@@ -131,8 +143,8 @@ fn print_natnet(nn: &Run, osc: &Run, relay: &harness::Seen, clients: usize) -> R
         let o = osc.seen.latency_us.value_at_quantile(q);
         let r = relay.latency_us.value_at_quantile(q);
         crate::out!(
-            "{label} added latency over natnet: {n} µs (osc {o} µs, ratio {:.2}x; relay {r} µs, \
-             ratio {:.2}x)",
+            "{label} added latency over natnet {how}: {n} µs (osc {o} µs, ratio {:.2}x; relay \
+             {r} µs, ratio {:.2}x)",
             n as f64 / o.max(1) as f64,
             n as f64 / r.max(1) as f64
         );

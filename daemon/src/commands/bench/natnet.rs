@@ -1,6 +1,6 @@
 //! The bench's NatNet source mode (`emoshift bench --natnet`): the same performers and
 //! receivers as the OSC rounds, but the frames come from a Motive stand-in on loopback
-//! (multicast, TTL 0), one NAT_FRAMEOFDATA per tick carrying every performer as a markerset,
+//! (multicast with TTL 0, Motive's default, or unicast), one NAT_FRAMEOFDATA per tick carrying every performer as a markerset,
 //! each frame's mid-exposure stamp the send time on the bench's clock (the stand-in's clock
 //! runs at 1 MHz from the bench's epoch), so the receivers time the same path end to end.
 
@@ -26,13 +26,14 @@ fn free_port() -> Result<u16> {
     Ok(UdpSocket::bind("127.0.0.1:0")?.local_addr()?.port())
 }
 
-/// Paced NatNet traffic through the daemon: `performers` markersets at `rate_hz` for `secs`.
+/// Paced NatNet traffic through the daemon: `performers` markersets at 120 Hz for `secs`,
+/// multicast (Motive's default) or unicast.
 pub(super) async fn through_daemon_natnet(
     model: &IcaModel,
-    performers: usize,
-    clients: usize,
+    (performers, clients): (usize, usize),
     secs: Duration,
     poll_window_us: u64,
+    multicast: bool,
 ) -> Result<Run> {
     let (receivers, addrs) = receivers(clients).await?;
     let names: Vec<String> = (0..performers).map(|p| format!("P{p}")).collect();
@@ -49,7 +50,7 @@ pub(super) async fn through_daemon_natnet(
     let group: SocketAddr = format!("239.255.42.99:{}", free_port()?).parse()?;
     let server = Motive::start(MotiveOptions {
         command: "127.0.0.1:0".parse()?,
-        multicast: Some(group),
+        multicast: multicast.then_some(group),
         version: NatNetVersion::V4_1,
         defs,
         epoch: epoch(),

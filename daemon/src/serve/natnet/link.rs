@@ -33,6 +33,14 @@ use crate::serve::net::{bind_receiver_std, RECV_BUFFER_BYTES};
 
 /// How often the owner hears the status even when nothing happens.
 const STATUS_EVERY: Duration = Duration::from_secs(1);
+/// How often a frame is decoded here to look for assets the model definitions lack.
+const FRAME_CHECK_EVERY: Duration = Duration::from_secs(1);
+
+/// A frame's "tracked models changed" flag (frame params bit 1), read in place: the params
+/// are the `u16` before the 4-byte end-of-data tag in NatNet 3.x and 4.x.
+fn models_changed(frame: &[u8]) -> bool {
+    frame.len() >= 10 && frame[frame.len() - 6] & 0x02 != 0
+}
 
 /// Where a link's frames go: the datagram, when it was received, the session that decodes it.
 pub type FrameSink<'a> = dyn FnMut(&[u8], Instant, &Arc<Session>) + Send + 'a;
@@ -72,6 +80,8 @@ pub struct Link {
     session: Option<Arc<Session>>,
     ids: LayoutIds,
     frame: FrameOfData,
+    /// When a frame is next decoded here (see [`FRAME_CHECK_EVERY`]).
+    next_frame_check: Instant,
     status: NatNetStatus,
     /// `FrameRate` is to be asked (after a connect) / has been asked and not answered.
     rate: (bool, bool),
@@ -105,6 +115,7 @@ impl Link {
             session: None,
             ids: LayoutIds::default(),
             frame: FrameOfData::with_capacity(1_000, 16),
+            next_frame_check: epoch,
             status,
             rate: (false, false),
             announced_rate_hz: None,
@@ -198,9 +209,15 @@ impl Link {
         };
         self.status.frames += 1;
         on_frame(bytes, now, session);
+        // The processing thread decodes the frame; the session needs it only to notice new
+        // models: at once when the frame says they changed, else once a second (an asset
+        // the model definitions do not describe yet).
+        let due = models_changed(bytes) || now >= self.next_frame_check;
         if incoming == Incoming::Frame
+            && due
             && decode_frame_into(bytes, session.layout.version, &mut self.frame).is_ok()
         {
+            self.next_frame_check = now + FRAME_CHECK_EVERY;
             self.client.handle_frame(now, &self.frame);
         }
     }
@@ -399,5 +416,26 @@ async fn recv(socket: Option<&UdpSocket>, buf: &mut [u8]) -> std::io::Result<usi
     match socket {
         Some(s) => s.recv(buf).await,
         None => std::future::pending().await,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use protocol::natnet::{encode_frame_into, FrameParams};
+
+    use super::*;
+
+    #[test]
+    fn the_models_changed_flag_is_read_in_place_in_3_x_and_4_x_frames() {
+        let mut f = FrameOfData::default();
+        f.push_markerset("Face", &[[1.0, 2.0, 3.0]]);
+        let mut bytes = Vec::new();
+        for v in [NatNetVersion::V3_0, NatNetVersion::V4_0, NatNetVersion::V4_1] {
+            for (params, changed) in [(0, false), (2, true), (1, false), (3, true)] {
+                f.params = FrameParams(params);
+                encode_frame_into(&f, v, &mut bytes).expect("encodable");
+                assert_eq!(models_changed(&bytes), changed, "{v} params {params}");
+            }
+        }
     }
 }
