@@ -213,12 +213,14 @@ fn header(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> [u8; BLOCK] {
     h
 }
 
+#[path = "write_timecode.rs"]
+mod timecode;
+
 /// Group ids.
 const POINT: i8 = 1;
 const ANALOG: i8 = 2;
 const FORCE_PLATFORM: i8 = 3;
 const TRIAL: i8 = 4;
-const TIMECODE: i8 = 5;
 
 fn parameters(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> Vec<u8> {
     let mut w = Records::default();
@@ -264,47 +266,9 @@ fn parameters(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> Vec<u8> {
         w.float(TRIAL, "CAMERA_RATE", &[rate as f32]);
     }
     if let Some(tc) = meta.time.and_then(|t| t.timecode) {
-        timecode_group(&mut w, &tc, meta.rate_hz);
+        timecode::group(&mut w, &tc, meta.rate_hz);
     }
     w.finish()
-}
-
-/// The TIMECODE group as Vicon writes it (read by e.g. mocap.ca's translators): USED, DROP_FRAMES,
-/// STANDARD (NTSC, PAL or FILM by nominal rate), SUBFRAMESPERFRAME (capture frames per
-/// timecode frame), OFFSETS (the first frame's subframe), TIMECODES (hh mm ss ff of the first
-/// frame); and RATE, the exact timecode rate, which STANDARD cannot say (29.97, 59.94).
-fn timecode_group(w: &mut Records, tc: &protocol::Smpte, rate_hz: f64) {
-    let fps = tc.rate.map_or(0.0, |r| r.fps());
-    let nominal = tc.rate.map_or(0, |r| r.nominal_fps());
-    w.group(TIMECODE, "TIMECODE", "SMPTE timecode of the first frame");
-    w.int(TIMECODE, "USED", &[1]);
-    w.byte(
-        TIMECODE,
-        "DROP_FRAMES",
-        u8::from(tc.rate.is_some_and(|r| r.drop_frame())),
-    );
-    let standard = match nominal {
-        30 | 60 => "NTSC".to_string(),
-        25 | 50 => "PAL".to_string(),
-        24 => "FILM".to_string(),
-        n => n.to_string(),
-    };
-    w.chars(TIMECODE, "STANDARD", &[standard]);
-    let per_frame = if fps > 0.0 {
-        (rate_hz / fps).round().max(1.0)
-    } else {
-        1.0
-    };
-    w.int_dims(TIMECODE, "SUBFRAMESPERFRAME", &[1, 1], &[per_frame as u16]);
-    w.int_dims(
-        TIMECODE,
-        "OFFSETS",
-        &[1, 1],
-        &[tc.subframe.min(u32::from(u16::MAX)) as u16],
-    );
-    let hmsf = [tc.hours, tc.minutes, tc.seconds, tc.frames].map(u16::from);
-    w.int_dims(TIMECODE, "TIMECODES", &[4, 1], &hmsf);
-    w.float(TIMECODE, "RATE", &[fps as f32]);
 }
 
 /// Builds group and parameter records; each record's "offset to next" is patched when the next
@@ -353,17 +317,6 @@ impl Records {
             vec![values.len() as u8]
         };
         self.param(group, name, 2, &dims, &data);
-    }
-
-    /// 16-bit integers with explicit dimensions (Vicon's TIMECODE group stores even single
-    /// values as 1 x 1 arrays).
-    fn int_dims(&mut self, group: i8, name: &str, dims: &[u8], values: &[u16]) {
-        let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        self.param(group, name, 2, dims, &data);
-    }
-
-    fn byte(&mut self, group: i8, name: &str, value: u8) {
-        self.param(group, name, 1, &[], &[value]);
     }
 
     fn float(&mut self, group: i8, name: &str, values: &[f32]) {

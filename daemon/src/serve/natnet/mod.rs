@@ -12,6 +12,7 @@ pub mod config;
 pub mod link;
 pub(super) mod source;
 pub mod status;
+mod wire;
 
 pub use config::{NatNetConfig, RawNatNet};
 pub use link::{Link, Session};

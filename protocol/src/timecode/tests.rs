@@ -1,5 +1,5 @@
 use super::*;
-use crate::{messages, Address, FrameBuf, Limits};
+use crate::{messages, Address, DecodeError, FrameBuf, Limits};
 
 fn df() -> TimecodeRate {
     TimecodeRate::DF_29_97
