@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Interop check: packets encoded by emoshift's NatNet stand-in must be accepted, strictly,
 by python_natnet's deserialize (an independent NatNet 3 implementation, BSD-3, kept in
-../shared only). Not wired into CI yet.
+../shared only). CI runs it from scripts/interop-natnet.
 
     pip install attrs
     PYTHONPATH=../shared/data/natnet/python_natnet python3 scripts/natnet_python_check.py

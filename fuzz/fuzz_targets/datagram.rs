@@ -18,6 +18,7 @@ fuzz_target!(|data: &[u8]| {
         total += m.bytes.len();
         match Address::parse(m.address) {
             Some(Address::Frame) => drop(decode_frame_into(m.bytes, &mut buf)),
+            Some(Address::Timecode) => drop(protocol::decode_timecode(m.bytes)),
             _ => drop(protocol::decode_control(m.bytes)),
         }
     }

@@ -2,6 +2,8 @@
 
 /// Input frame, `,ihbb` (blob form) or `,ih` + 3n `f` (flat form).
 pub const FRAME: &str = "/mocap/frame";
+/// The source's SMPTE timecode and clock of the frame in the same bundle, `,iiiii`.
+pub const TIMECODE: &str = "/mocap/timecode";
 /// Marker names of a layout, `,i s...`.
 pub const LABELS: &str = "/mocap/labels";
 /// One part of a flat-split output frame, `,iiii f...`.
@@ -60,6 +62,8 @@ pub enum Address {
     Frame,
     /// [`LABELS`]
     Labels,
+    /// [`TIMECODE`]
+    Timecode,
     /// [`PART`]
     Part,
     /// [`STATE`]
@@ -105,6 +109,7 @@ impl Address {
         Some(match address {
             FRAME => Address::Frame,
             LABELS => Address::Labels,
+            TIMECODE => Address::Timecode,
             PART => Address::Part,
             STATE => Address::State,
             STREAM => Address::Stream,

@@ -15,6 +15,7 @@
 //! | `/mocap/frame` | `,ihbb` | source → daemon, daemon → compact clients | frame number; capture time µs (sender's clock); missing-marker bitmask (marker i = bit i mod 8, LSB first, of byte i div 8); positions, markers × 3 f32 mm, x y z |
 //! | `/mocap/frame` | `,ih` + 3n × `f` | source → daemon | flat form, a marker with all three NaN is missing |
 //! | `/mocap/labels` | `,i` + n × `s` | source → daemon, at start and every second | layout id, marker names in frame order |
+//! | `/mocap/timecode` | `,iiiii` | source → daemon, daemon → compact and components clients, in the frame's bundle | SMPTE timecode packed `hh<<24\|mm<<16\|ss<<8\|ff`, subframe, rate numerator, rate denominator (0/1 unknown), flags (bit 0 timecode present, bit 1 drop-frame, bit 2 capture time is UTC µs); see [`decode_timecode`] |
 //! | `/emoshift/state` | `,sf` | daemon → compact | target emotion, current amount (after the frame, same bundle) |
 //! | `/mocap/part` | `,iiii` + 3k × `f` | daemon → flat-split | frame number, first marker, k markers here, markers in frame, then x y z per marker (NaN = missing); each ≤ 1,472 bytes |
 //! | `/emoshift/components` | n × `f` | daemon → components | current u |
@@ -98,6 +99,7 @@ pub mod natnet;
 mod output;
 mod reply;
 mod scan;
+mod timecode;
 mod wire;
 
 pub use address::Address;
@@ -126,4 +128,8 @@ pub use reply::{
 pub use scan::{
     check_datagram, messages, Limits, Message, Messages, TimeTag, BUNDLE_DEPTH_CAP,
     DEFAULT_MAX_BUNDLE_DEPTH, MAX_ARRAY_DEPTH, MAX_UDP_PAYLOAD,
+};
+pub use timecode::{
+    append_timecode_element, decode_timecode, encode_frame_timed_into, encode_timecode_into,
+    CaptureClock, FrameTime, Smpte, TimecodeError, TimecodeRate, TIMECODE_MESSAGE_LEN,
 };

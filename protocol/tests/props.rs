@@ -147,11 +147,47 @@ proptest! {
         let _ = decode_reply(&bytes);
         let _ = decode_part_into(&bytes, &mut pos);
         let _ = decode_components_into(&bytes, &mut u);
+        let _ = decode_timecode(&bytes);
         if let Ok(msgs) = messages(&bytes, &Limits::default()) {
             for m in msgs {
                 let _ = decode_frame_into(m.bytes, &mut g);
                 let _ = decode_control(m.bytes);
+                let _ = decode_timecode(m.bytes);
             }
+        }
+    }
+
+    /// Issue 16: the timecode message round-trips (drop-frame included) and rosc reads the
+    /// same five ints.
+    #[test]
+    fn timecodes_round_trip_and_agree_with_rosc(
+        count in 0u64..5_000_000,
+        sub in 0u32..16,
+        rate in prop::sample::select(vec!["24", "25", "29.97df", "30", "59.94df", "23.976"]),
+        utc in any::<bool>(),
+        has in any::<bool>(),
+    ) {
+        let rate = TimecodeRate::parse(rate).expect("listed rates parse");
+        let mut t = Smpte::from_frame_count(count, rate);
+        t.subframe = sub;
+        let time = FrameTime {
+            timecode: has.then_some(t),
+            clock: if utc { CaptureClock::Utc } else { CaptureClock::Source },
+        };
+        let mut out = Vec::new();
+        encode_timecode_into(&time, &mut out);
+        prop_assert_eq!(decode_timecode(&out), Ok(time));
+        let m = decode_osc(&out).map_err(TestCaseError::fail)?;
+        prop_assert_eq!(m.addr.as_str(), "/mocap/timecode");
+        let ints: Vec<i32> = m.args.iter().filter_map(|a| match a {
+            OscType::Int(v) => Some(*v),
+            _ => None,
+        }).collect();
+        prop_assert_eq!(ints.len(), 5);
+        if has {
+            prop_assert_eq!(ints[0] as u32, t.packed());
+            prop_assert_eq!(ints[1] as u32, sub);
+            prop_assert_eq!(ints[2] as u32, rate.numerator());
         }
     }
 

@@ -45,8 +45,20 @@ use crate::error::{TakeError, WriteError};
 use crate::trc::text::{check_labels, push_sample};
 use crate::{Format, Take};
 
-/// Width of the TRC frame-count placeholder: any `u64` fits.
-const COUNT_WIDTH: usize = 20;
+#[path = "record_trc.rs"]
+mod trc_header;
+use trc_header::{trc_header, COUNT_WIDTH, RATE_WIDTH};
+
+/// What a live recording knows besides labels, rate and first frame (issue 16).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RecordTime {
+    /// The first frame's SMPTE timecode: in TRC's header (`Timecode`) and C3D's TIMECODE
+    /// group; with it a CSV recording has a `timecode` column, one per frame.
+    pub timecode: Option<protocol::Smpte>,
+    /// The rate measured from the source (C3D `TRIAL:CAMERA_RATE`, TRC `CameraRate`); may
+    /// also be set before finishing ([`Recorder::set_camera_rate`]).
+    pub camera_rate_hz: Option<f64>,
+}
 /// Write buffer: a few frames of a large layout, so the kernel sees few, large writes.
 const BUFFER_BYTES: usize = 64 * 1024;
 
@@ -78,6 +90,10 @@ pub struct Recorder {
     count_at: [u64; 2],
     /// C3D: parameter blocks reserved.
     c3d_blocks: usize,
+    /// Timecode and measured rate.
+    time: RecordTime,
+    /// TRC: byte offset of the `CameraRate` placeholder.
+    camera_rate_at: u64,
     /// One formatted row (text formats), reused.
     line: String,
     /// One encoded frame (C3D), reused.
@@ -98,6 +114,21 @@ impl Recorder {
         rate_hz: f64,
         first_frame: i64,
     ) -> Result<Recorder, WriteError> {
+        Recorder::create_timed(path, labels, rate_hz, first_frame, RecordTime::default())
+    }
+
+    /// [`Recorder::create`] with the first frame's timecode and a measured rate (see
+    /// [`RecordTime`]).
+    ///
+    /// # Errors
+    /// As [`Recorder::create`].
+    pub fn create_timed(
+        path: &Path,
+        labels: Vec<String>,
+        rate_hz: f64,
+        first_frame: i64,
+        time: RecordTime,
+    ) -> Result<Recorder, WriteError> {
         let format =
             Format::from_path(path).ok_or_else(|| WriteError::UnknownFormat(path.into()))?;
         let probe = Take::new(labels, rate_hz, first_frame);
@@ -109,9 +140,15 @@ impl Recorder {
             Format::Csv => check_labels(&labels, "csv", &[',', '"', '\n', '\r'])?,
             Format::C3d => {
                 c3d::check_labels(&labels)?;
+                // Room for a camera rate set later.
+                let reserve = RecordTime {
+                    camera_rate_hz: time.camera_rate_hz.or(Some(rate_hz)),
+                    ..time
+                };
                 let meta = Meta {
                     labels: &labels,
                     rate_hz,
+                    time: Some(&reserve),
                 };
                 c3d_blocks = c3d::parameter_blocks(&meta, &FrameRange::longest(first_frame)?)?;
             }
@@ -129,6 +166,8 @@ impl Recorder {
             frames: 0,
             count_at: [0; 2],
             c3d_blocks,
+            time,
+            camera_rate_at: 0,
         };
         rec.write_header()?;
         Ok(rec)
@@ -151,6 +190,9 @@ impl Recorder {
             Format::Csv => {
                 writeln!(text, "# rate_hz={} units=mm", self.rate_hz).expect("String write");
                 text.push_str("frame,time");
+                if self.time.timecode.is_some() {
+                    text.push_str(",timecode");
+                }
                 for label in &self.labels {
                     for axis in ["x", "y", "z"] {
                         write!(text, ",{label}_{axis}").expect("String write");
@@ -159,7 +201,9 @@ impl Recorder {
                 text.push('\n');
             }
             Format::Trc => {
-                self.count_at = trc_header(&mut text, &self.labels, self.rate_hz, self.first_frame)
+                let (rate, first, tc) = (self.rate_hz, self.first_frame, self.time.timecode);
+                let at = trc_header(&mut text, &self.labels, (rate, first), tc.as_ref());
+                [self.count_at[0], self.count_at[1], self.camera_rate_at] = at;
             }
         }
         self.writer().write_all(text.as_bytes())?;
@@ -170,6 +214,14 @@ impl Recorder {
         Meta {
             labels: &self.labels,
             rate_hz: self.rate_hz,
+            time: Some(&self.time),
+        }
+    }
+
+    /// Sets the measured rate written on finish (C3D `TRIAL:CAMERA_RATE`, TRC `CameraRate`).
+    pub fn set_camera_rate(&mut self, rate_hz: f64) {
+        if rate_hz.is_finite() && rate_hz > 0.0 {
+            self.time.camera_rate_hz = Some(rate_hz);
         }
     }
 
@@ -187,6 +239,20 @@ impl Recorder {
     /// finite (nothing is written for that frame), [`WriteError::C3dLimit`] past the 32-bit
     /// frame numbers of C3D, or an I/O error.
     pub fn push_frame(&mut self, xyz: &[f32], missing: &[bool]) -> Result<(), WriteError> {
+        self.push_frame_timed(xyz, missing, None)
+    }
+
+    /// [`Recorder::push_frame`] with the frame's timecode, for the CSV `timecode` column (a
+    /// frame without one leaves its cell empty; other formats keep only the first frame's).
+    ///
+    /// # Errors
+    /// As [`Recorder::push_frame`].
+    pub fn push_frame_timed(
+        &mut self,
+        xyz: &[f32],
+        missing: &[bool],
+        timecode: Option<&protocol::Smpte>,
+    ) -> Result<(), WriteError> {
         let n = self.labels.len();
         if xyz.len() != n * 3 || missing.len() != n {
             return Err(TakeError::ShapeMismatch {
@@ -222,7 +288,9 @@ impl Recorder {
                     ','
                 };
                 let mut line = std::mem::take(&mut self.line);
-                self.format_row(&mut line, sep, xyz, missing);
+                let tc = (self.format == Format::Csv && self.time.timecode.is_some())
+                    .then_some(timecode);
+                self.format_row(&mut line, sep, (xyz, missing), tc);
                 let written = self.writer().write_all(line.as_bytes());
                 self.line = line;
                 written?;
@@ -233,11 +301,24 @@ impl Recorder {
     }
 
     /// One text row, as `trc::write` and `csv::write` format it.
-    fn format_row(&self, line: &mut String, sep: char, xyz: &[f32], missing: &[bool]) {
+    /// `timecode`: `Some` when the row has a timecode cell (empty for `Some(None)`).
+    fn format_row(
+        &self,
+        line: &mut String,
+        sep: char,
+        (xyz, missing): (&[f32], &[bool]),
+        timecode: Option<Option<&protocol::Smpte>>,
+    ) {
         line.clear();
         let number = self.first_frame.wrapping_add(self.frames as i64);
         let time = self.frames as f64 / self.rate_hz;
         write!(line, "{number}{sep}{time:.6}").expect("writing to a String cannot fail");
+        if let Some(tc) = timecode {
+            line.push(sep);
+            if let Some(tc) = tc {
+                write!(line, "{tc}").expect("writing to a String cannot fail");
+            }
+        }
         for (p, &gone) in xyz.chunks_exact(3).zip(missing) {
             for &v in p {
                 line.push(sep);
@@ -281,6 +362,11 @@ impl Recorder {
                     file.seek(SeekFrom::Start(at))?;
                     file.write_all(count.as_bytes())?;
                 }
+                let rate = self.time.camera_rate_hz.unwrap_or(self.rate_hz);
+                let mut rate = format!("{rate:.6}");
+                rate.truncate(RATE_WIDTH);
+                file.seek(SeekFrom::Start(self.camera_rate_at))?;
+                file.write_all(format!("{rate:<RATE_WIDTH$}").as_bytes())?;
             }
             Format::C3d => self.patch_c3d(&mut file)?,
         }
@@ -318,28 +404,4 @@ impl Drop for Recorder {
             let _ = self.finalise();
         }
     }
-}
-
-/// Writes the TRC header with blank-padded frame counts into `text`; returns the byte offsets of
-/// the two counts.
-fn trc_header(text: &mut String, labels: &[String], rate: f64, first: i64) -> [u64; 2] {
-    let n = labels.len();
-    let blank = format!("{:<COUNT_WIDTH$}", 0);
-    text.push_str("PathFileType\t4\t(X/Y/Z)\ttake.trc\n");
-    text.push_str("DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames\n");
-    write!(text, "{rate}\t{rate}\t").expect("String write");
-    let num_frames = text.len() as u64;
-    write!(text, "{blank}\t{n}\tmm\t{rate}\t{first}\t").expect("String write");
-    let orig_num_frames = text.len() as u64;
-    writeln!(text, "{blank}").expect("String write");
-    text.push_str("Frame#\tTime");
-    for label in labels {
-        write!(text, "\t{label}\t\t").expect("String write");
-    }
-    text.push_str("\n\t");
-    for k in 1..=n {
-        write!(text, "\tX{k}\tY{k}\tZ{k}").expect("String write");
-    }
-    text.push_str("\n\n");
-    [num_frames, orig_num_frames]
 }

@@ -221,3 +221,72 @@ fn frames_reach_the_file_as_they_are_pushed() {
         assert_eq!(replay::load(&path).unwrap().n_frames(), 600);
     }
 }
+
+/// Issue 16: a live recording keeps its timecode: a CSV column per frame, the first frame's in
+/// TRC's header and C3D's TIMECODE group (drop-frame included), the measured rate as TRC's
+/// CameraRate and C3D's TRIAL:CAMERA_RATE; all three still read back as takes.
+#[test]
+fn timecode_and_measured_rate_go_into_every_format() {
+    use protocol::{Smpte, TimecodeRate};
+    use replay::record::RecordTime;
+    let dir = tempfile::tempdir().unwrap();
+    let labels = vec!["Chin".to_string(), "Nose".to_string()];
+    let rate = TimecodeRate::DF_29_97;
+    // 120 Hz capture on 29.97 DF timecode: 4 subframes a timecode frame, across a minute.
+    let first = Smpte::from_frame_count(1_799, rate);
+    let stamp = |k: u32| {
+        let mut t = Smpte::from_frame_count(1_799 + u64::from(k / 4), rate);
+        t.subframe = k % 4;
+        t
+    };
+    for ext in ["csv", "trc", "c3d"] {
+        let path = dir.path().join(format!("live.{ext}"));
+        let time = RecordTime {
+            timecode: Some(first),
+            camera_rate_hz: None,
+        };
+        let mut rec = Recorder::create_timed(&path, labels.clone(), 120.0, 1, time).unwrap();
+        for k in 0..8u32 {
+            let xyz = [1.0, 2.0, k as f32, 4.0, 5.0, 6.0];
+            rec.push_frame_timed(&xyz, &[false, k == 3], Some(&stamp(k)))
+                .unwrap();
+        }
+        rec.set_camera_rate(119.88);
+        rec.finish().unwrap();
+        let take = replay::load(&path).unwrap();
+        assert_eq!((take.n_frames(), take.sample(3, 1)), (8, None), "{ext}");
+        let text = std::fs::read(&path).unwrap();
+        match ext {
+            "csv" => {
+                let text = String::from_utf8(text).unwrap();
+                let rows: Vec<&str> = text.lines().skip(2).collect();
+                assert!(text
+                    .lines()
+                    .nth(1)
+                    .unwrap()
+                    .starts_with("frame,time,timecode,"));
+                assert_eq!(rows[0].split(',').nth(2), Some("00:00:59;29.0"));
+                assert_eq!(
+                    rows[4].split(',').nth(2),
+                    Some("00:01:00;02.0"),
+                    "DF skips ;00 ;01"
+                );
+                assert_eq!(rows[7].split(',').nth(2), Some("00:01:00;02.3"));
+            }
+            "trc" => {
+                let text = String::from_utf8(text).unwrap();
+                let keys: Vec<&str> = text.lines().nth(1).unwrap().split('\t').collect();
+                let values: Vec<&str> = text.lines().nth(2).unwrap().split('\t').collect();
+                let at = |k: &str| values[keys.iter().position(|x| *x == k).unwrap()].trim();
+                assert_eq!(at("Timecode"), "00:00:59;29.0");
+                assert_eq!(at("CameraRate"), "119.880000");
+                assert_eq!(at("DataRate"), "120");
+            }
+            _ => {
+                let back = replay::c3d::read_time(&text).unwrap();
+                assert_eq!(back.timecode, Some(first));
+                assert!((back.camera_rate_hz.unwrap() - 119.88).abs() < 1e-3);
+            }
+        }
+    }
+}

@@ -26,6 +26,46 @@ pub struct ServeArgs {
     /// Low-pass window of the emotion edit, seconds [default: 1].
     #[arg(long)]
     pub lowpass: Option<f32>,
+    /// Take frames from an OptiTrack Motive NatNet server too: its command channel,
+    /// IP[:PORT] [port 1510]. Each markerset becomes a stream, beside the OSC frame socket.
+    #[arg(long, value_name = "SERVER[:PORT]")]
+    pub natnet: Option<String>,
+    /// The NatNet source's settings.
+    #[command(flatten)]
+    pub natnet_options: NatNetArgs,
+}
+
+/// The NatNet options `serve` and `record` share (each needs `--natnet`).
+#[derive(Debug, Args)]
+pub struct NatNetArgs {
+    /// Where NatNet frames arrive: a multicast group (joined on --natnet-interface) or a
+    /// local unicast address [default: what the server announces].
+    #[arg(long, value_name = "ADDR:PORT", requires = "natnet")]
+    pub natnet_data: Option<String>,
+    /// Local IPv4 address to join the NatNet multicast group on.
+    #[arg(long, value_name = "IP", requires = "natnet")]
+    pub natnet_interface: Option<String>,
+    /// Rate of Motive's timecode, which NatNet does not send (24, 25, 29.97df, 30, 59.94df...).
+    #[arg(long, value_name = "RATE", requires = "natnet")]
+    pub natnet_timecode_rate: Option<String>,
+    /// NatNet marker names: asset:marker (as Motive exports them; default), asset_marker, or
+    /// marker.
+    #[arg(long, value_name = "STYLE", requires = "natnet")]
+    pub natnet_names: Option<String>,
+}
+
+impl NatNetArgs {
+    /// These options over the `natnet` keys of a config.
+    pub fn raw(&self, server: Option<String>) -> crate::serve::natnet::RawNatNet {
+        crate::serve::natnet::RawNatNet {
+            server,
+            data: self.natnet_data.clone(),
+            interface: self.natnet_interface.clone(),
+            timecode_rate: self.natnet_timecode_rate.clone(),
+            names: self.natnet_names.clone(),
+            ..Default::default()
+        }
+    }
 }
 
 /// `emoshift bench`.
@@ -43,6 +83,42 @@ pub struct BenchArgs {
     /// The daemon's `poll_window_us` (0: the processing thread always parks).
     #[arg(long, default_value_t = crate::serve::config::DEFAULT_POLL_WINDOW_US)]
     pub poll_window_us: u64,
+    /// Also feed the daemon from a NatNet server (a Motive stand-in on loopback, multicast),
+    /// in rounds alternating with the OSC source and the relay: frames lost over NatNet, and
+    /// its added latency against OSC's in the same run.
+    #[arg(long)]
+    pub natnet: bool,
+}
+
+/// `emoshift record`.
+#[derive(Debug, Args)]
+pub struct RecordArgs {
+    /// Take OSC frames on this socket, IP:PORT (what `emoshift replay --to` or a stage bridge
+    /// sends to).
+    #[arg(long, value_name = "IP:PORT", conflicts_with = "natnet")]
+    pub listen: Option<String>,
+    /// Take frames from a NatNet server (OptiTrack Motive): its command channel, IP[:PORT].
+    #[arg(long, value_name = "SERVER[:PORT]")]
+    pub natnet: Option<String>,
+    /// The NatNet source's settings.
+    #[command(flatten)]
+    pub natnet_options: NatNetArgs,
+    /// The file, .c3d, .trc or .csv.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Replace --out if it exists.
+    #[arg(long)]
+    pub force: bool,
+    /// Stop after this many frames (gaps included).
+    #[arg(long, value_name = "N", conflicts_with = "seconds")]
+    pub frames: Option<u64>,
+    /// Stop after this many seconds of capture.
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// The stream to record: a NatNet markerset (asset) name, or `IP:PORT/LAYOUT` of an OSC
+    /// source [default: the first stream that arrives].
+    #[arg(long, value_name = "NAME")]
+    pub performer: Option<String>,
 }
 
 /// `emoshift replay`.

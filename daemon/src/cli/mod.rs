@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 mod live;
 mod offline;
 
-pub use live::{BenchArgs, DemoArgs, ReplayArgs, ServeArgs, WireFormat};
+pub use live::{BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, WireFormat};
 pub use offline::{
     AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InspectArgs, KeyValue, ProjectArgs, SynthArgs,
     TrainArgs,
@@ -89,6 +89,15 @@ pub enum Command {
         emoshift replay take.trc --to 127.0.0.1:9000 --speed 2 --loop --start-frame 120"
     )]
     Replay(ReplayArgs),
+    /// Capture a take from a live source (OSC or a NatNet server) to C3D, TRC or CSV, with its
+    /// labels, rate, gaps and timecode; Ctrl-C leaves the file complete.
+    #[command(
+        after_help = "Examples:\n  emoshift record --listen 127.0.0.1:9000 --out take.c3d --seconds 30\n  \
+        emoshift record --natnet 192.168.0.106 --out face.csv --performer Face --frames 3600\n  \
+        emoshift record --natnet 10.0.0.5:1510 --natnet-data 239.255.42.99:1511 \
+        --natnet-interface 10.0.0.20 --natnet-timecode-rate 29.97df --out take.trc"
+    )]
+    Record(RecordArgs),
     /// Run the whole chain on an embedded default: synth, train, analyze, serve, replay with an
     /// emotion sweep, receive, summarise.
     #[command(

@@ -9,6 +9,7 @@ mod info;
 mod inspect;
 pub mod progress;
 mod project;
+mod record;
 mod replay;
 mod serve;
 mod synth;
@@ -56,6 +57,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Serve(args) => serve::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Replay(args) => replay::run(&args),
+        Command::Record(args) => record::run(&args),
         Command::Demo(args) => demo::run(&args),
     }
 }

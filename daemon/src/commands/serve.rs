@@ -38,6 +38,18 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if let Some(l) = args.lowpass {
         raw.lowpass_s = Some(l);
     }
+    let flags = args.natnet_options.raw(args.natnet.clone());
+    for (flag, key) in [
+        (flags.server, &mut raw.natnet),
+        (flags.data, &mut raw.natnet_data),
+        (flags.interface, &mut raw.natnet_interface),
+        (flags.timecode_rate, &mut raw.natnet_timecode_rate),
+        (flags.names, &mut raw.natnet_names),
+    ] {
+        if flag.is_some() {
+            *key = flag;
+        }
+    }
     raw.validate().map_err(|e| UsageError(e.to_string()).into())
 }
 
@@ -66,7 +78,7 @@ pub(crate) fn run(args: &ServeArgs) -> Result<()> {
 }
 
 /// Cancels `token` on Ctrl-C or SIGTERM.
-async fn cancel_on_signal(token: CancellationToken) {
+pub(crate) async fn cancel_on_signal(token: CancellationToken) {
     #[cfg(unix)]
     {
         use tokio::signal::unix::{signal, SignalKind};

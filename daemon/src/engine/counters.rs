@@ -34,6 +34,8 @@ pub struct Counters {
     pub restarts: u64,
     /// Models swapped in.
     pub model_swaps: u64,
+    /// NatNet frames that did not decode.
+    pub bad_natnet: u64,
     /// Bad packets by [`DecodeErrorKind`].
     pub bad: [u64; DecodeErrorKind::ALL.len()],
 }

@@ -34,6 +34,12 @@
 //! 8. `emit` sends the bytes to every subscriber of that profile from the processing thread
 //!    (`serve::sender::Fanout`), then hands the frame to the recording, if one runs.
 //!
+//! A NatNet frame (OptiTrack Motive) enters at step 4 instead:
+//! [`Pipeline::handle_natnet`] decodes the NAT_FRAMEOFDATA once ([`natnet`]: names, mm,
+//! occlusion, timecode) and sends each markerset down steps 4 to 7 as one stream's frame. A
+//! `/mocap/timecode` in a datagram, or a NatNet frame's timecode, rides along to the outputs
+//! ([`Emitted::time`]).
+//!
 //! Edits and model swaps reach the engine between two datagrams, so no frame sees half a
 //! change ([`Pipeline::handle_edit`], [`Pipeline::set_model`]). Who is subscribed, and until
 //! when, is [`clients`]; the shell asks it with its own `now`.
@@ -43,6 +49,7 @@ mod counters;
 pub mod edit_state;
 pub mod frame;
 pub mod layout;
+pub mod natnet;
 pub mod pipeline;
 pub mod stream;
 pub mod streams;

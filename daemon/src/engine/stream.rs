@@ -216,6 +216,11 @@ impl Stream {
         &self.out
     }
 
+    /// The source's labels, in the order of its frames.
+    pub fn source_labels(&self) -> &[String] {
+        &self.source_labels
+    }
+
     /// The output's `/mocap/labels` (empty when a label cannot be sent).
     pub fn labels_msg(&self) -> &[u8] {
         &self.labels_msg

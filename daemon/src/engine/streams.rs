@@ -59,6 +59,8 @@ pub struct Performer<M = Arc<IcaModel>> {
     pub source: Option<SocketAddr>,
     /// Only frames of this layout id (any when `None`).
     pub layout: Option<i32>,
+    /// Only the NatNet markerset (Motive asset) of this name (any when `None`).
+    pub markerset: Option<String>,
     /// Its model (the loaded model when `None`).
     pub model: Option<M>,
     /// Default target emotion.
@@ -78,15 +80,25 @@ impl<M> Performer<M> {
             name: self.name,
             source: self.source,
             layout: self.layout,
+            markerset: self.markerset,
             target: self.target,
             amount: self.amount,
         }
     }
 
-    /// Whether this performer owns a stream.
+    /// Whether this performer owns a stream of an OSC source.
     pub fn owns(&self, key: &StreamKey) -> bool {
+        self.owns_stream(key, None)
+    }
+
+    /// Whether this performer owns a stream, which is NatNet markerset `markerset` if named.
+    pub fn owns_stream(&self, key: &StreamKey, markerset: Option<&str>) -> bool {
         self.source.is_none_or(|s| s == key.source)
             && self.layout.is_none_or(|l| l == key.layout_id)
+            && self
+                .markerset
+                .as_deref()
+                .is_none_or(|m| Some(m) == markerset)
     }
 }
 
@@ -144,6 +156,11 @@ impl Streams {
             Entry::Occupied(e) => Some(e.into_mut()),
             Entry::Vacant(_) => None,
         }
+    }
+
+    /// The stream of `key`, if it exists.
+    pub fn get(&self, key: &StreamKey) -> Option<&Stream> {
+        self.map.get(key)
     }
 
     /// Drops the streams of one source and layout (its labels changed).
@@ -208,10 +225,21 @@ mod tests {
             name: "alice".into(),
             source: Some(a),
             layout: None,
+            markerset: None,
             model: None,
             target: None,
             amount: None,
         };
+        let face = Performer {
+            markerset: Some("Face".into()),
+            ..p.clone()
+        };
+        let k = StreamKey {
+            source: a,
+            layout_id: 0,
+        };
+        assert!(face.owns_stream(&k, Some("Face")));
+        assert!(!face.owns_stream(&k, Some("Body")) && !face.owns(&k));
         assert!(p.owns(&StreamKey {
             source: a,
             layout_id: 3

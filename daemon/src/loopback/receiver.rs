@@ -39,6 +39,8 @@ pub struct Received<'a> {
     pub state: Option<State<'a>>,
     /// Component values (components profile).
     pub components: Option<&'a [f32]>,
+    /// The source's timecode and clock, when the frame came with them.
+    pub time: Option<protocol::FrameTime>,
 }
 
 /// A loopback socket the daemon sends to.
@@ -198,13 +200,14 @@ where
             continue;
         };
         let (mut header, mut state, mut components) = (None, None, None);
-        let (mut stream, mut labels) = (None, None);
+        let (mut stream, mut labels, mut time) = (None, None, None);
         for m in msgs {
             match Address::parse(m.address) {
                 Some(Address::Stream) => stream = decode_stream(m.bytes).ok(),
                 Some(Address::Labels) => labels = decode_labels(m.bytes).ok(),
                 Some(Address::Frame) => header = decode_frame_into(m.bytes, &mut frame).ok(),
                 Some(Address::State) => state = decode_state(m.bytes).ok(),
+                Some(Address::Timecode) => time = protocol::decode_timecode(m.bytes).ok(),
                 Some(Address::Components) => {
                     components = decode_components_into(m.bytes, &mut u).ok();
                 }
@@ -218,6 +221,7 @@ where
             frame: header.map(|h| (h, &frame)),
             state,
             components: components.map(|k| &u[..k]),
+            time,
         };
         sink(&mut kept, &got);
     }

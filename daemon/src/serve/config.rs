@@ -2,6 +2,7 @@
 //! unknown keys rejected by name) with CLI flags laid over it, then one [`RawConfig::validate`]
 //! into a [`Config`]. Defaults bind loopback only.
 
+use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -39,6 +40,8 @@ pub struct RawPerformer {
     pub source: Option<String>,
     /// Layout id whose frames are this performer's.
     pub layout: Option<i32>,
+    /// NatNet markerset (Motive asset) whose frames are this performer's.
+    pub markerset: Option<String>,
     /// Default target emotion.
     pub emotion: Option<String>,
     /// Default amount.
@@ -81,6 +84,18 @@ pub struct RawConfig {
     pub max_model_mb: Option<u64>,
     /// Named performers.
     pub performers: Vec<RawPerformer>,
+    /// NatNet server to take frames from, `IP[:PORT]` (see [`super::natnet`]).
+    pub natnet: Option<String>,
+    /// Where NatNet frames arrive (multicast group or local address), `IP:PORT`.
+    pub natnet_data: Option<String>,
+    /// Local IPv4 address the NatNet multicast group is joined on.
+    pub natnet_interface: Option<String>,
+    /// Rate of the NatNet source's timecode (`29.97df`, `30`, ...).
+    pub natnet_timecode_rate: Option<String>,
+    /// How NatNet markers are named: `asset:marker`, `asset_marker` or `marker`.
+    pub natnet_names: Option<String>,
+    /// NatNet marker names (as built) to model labels.
+    pub natnet_rename: HashMap<String, String>,
 }
 
 /// The validated configuration; the only form that travels on.
@@ -118,6 +133,8 @@ pub struct Config {
     pub max_model_bytes: u64,
     /// Performers.
     pub performers: Vec<PerformerConfig>,
+    /// The NatNet source, if any.
+    pub natnet: Option<super::natnet::NatNetConfig>,
 }
 
 /// Why a configuration is refused; each names the key and the value.
@@ -237,6 +254,15 @@ impl RawConfig {
                 .into_iter()
                 .map(performer)
                 .collect::<Result<_, _>>()?,
+            natnet: super::natnet::RawNatNet {
+                server: self.natnet,
+                data: self.natnet_data,
+                interface: self.natnet_interface,
+                timecode_rate: self.natnet_timecode_rate,
+                names: self.natnet_names,
+                rename: self.natnet_rename,
+            }
+            .validate()?,
         })
     }
 
@@ -350,6 +376,7 @@ fn performer(p: RawPerformer) -> Result<PerformerConfig, ConfigError> {
         model: p.model,
         source,
         layout: p.layout,
+        markerset: p.markerset,
         target: p.emotion,
         amount: p.amount,
     })

@@ -12,22 +12,28 @@
 //! - [`arrival`]: when the processing thread polls instead of parking (a steady source's
 //!   beat);
 //! - [`record`]: recordings of the edited stream and the raw input;
-//! - [`net`]: sockets (large receive buffers, connected senders).
+//! - [`net`]: sockets (large receive buffers, connected senders);
+//! - [`natnet`]: OptiTrack Motive's NatNet stream as a source beside the OSC frame socket;
+//! - [`capture`]: `emoshift record`, a live source (OSC or NatNet) captured to one file.
 //!
 //! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
 //! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).
 
 pub mod allow;
 pub mod arrival;
+pub mod capture;
 mod command;
 pub mod config;
 mod control;
 mod guard;
+mod latency;
+pub mod natnet;
 pub mod net;
-mod processing;
+pub(crate) mod processing;
 pub mod record;
+mod record_sink;
 mod sender;
-mod server;
+pub(crate) mod server;
 pub mod stats;
 
 pub use config::Config;

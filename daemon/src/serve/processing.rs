@@ -39,6 +39,8 @@ pub(crate) struct InFrame {
     pub(crate) peer: SocketAddr,
     pub(crate) bytes: Vec<u8>,
     pub(crate) received: Instant,
+    /// A NAT_FRAMEOFDATA and the NatNet session that decodes it; `None` for OSC.
+    pub(crate) natnet: Option<Arc<crate::serve::natnet::Session>>,
 }
 
 /// The processing thread's ends of the channels.
@@ -97,6 +99,8 @@ pub(crate) struct Processing {
     /// When the counters were last merged into the shared stats.
     last_merge: Instant,
     processed_us: hdrhistogram::Histogram<u64>,
+    /// Per stream id, capture → processed (see [`super::latency`]).
+    latency: super::latency::StreamLatency,
 }
 
 impl Processing {
@@ -129,6 +133,7 @@ impl Processing {
             closing: Vec::new(),
             last_merge: Instant::now(),
             processed_us: Stats::histogram(),
+            latency: super::latency::StreamLatency::default(),
         };
         processing.pipeline.set_wanted(processing.fanout.wanted());
         processing
@@ -241,22 +246,29 @@ impl Processing {
             fanout,
             recording,
             processed_us,
+            latency,
             ..
         } = self;
         let received = frame.received;
+        let natnet = frame.natnet.as_deref();
         let mut clients_changed = false;
-        pipeline.handle_datagram(frame.peer, &frame.bytes, &mut |e: &Emitted<'_>| {
+        let mut emit = |e: &Emitted<'_>| {
             let processed = Instant::now();
             Stats::record(
                 processed_us,
                 processed.duration_since(received).as_micros() as u64,
             );
+            latency.record(e, natnet, processed);
             // Send before recording: the file write is not on the subscribers' path.
             clients_changed |= fanout.send(e, processed);
             if let Some(rec) = recording.as_mut() {
                 rec.push(e);
             }
-        });
+        };
+        match natnet {
+            Some(s) => pipeline.handle_natnet(s.server, &frame.bytes, &s.layout, &mut emit),
+            None => pipeline.handle_datagram(frame.peer, &frame.bytes, &mut emit),
+        }
         if clients_changed {
             self.pipeline.set_wanted(self.fanout.wanted());
         }
@@ -325,6 +337,7 @@ impl Processing {
         self.processed_us.reset();
         let _ = s.sent_us.add(&self.fanout.sent_us);
         self.fanout.sent_us.reset();
+        self.latency.merge_into(&mut s.stream_latency_us);
     }
 
     fn command(&mut self, request: Request) {

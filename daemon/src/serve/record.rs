@@ -14,7 +14,7 @@
 
 use std::path::{Path, PathBuf};
 
-use replay::record::Recorder;
+use super::record_sink::{Frame, Sink};
 
 use crate::engine::pipeline::Emitted;
 use crate::engine::streams::StreamKey;
@@ -62,87 +62,6 @@ pub enum RecordError {
         /// Why.
         message: String,
     },
-}
-
-/// Lost frame numbers filled with all-missing rows at most (a minute at 120 Hz); a longer
-/// pause is written as if it had not happened, and logged.
-const MAX_FILL: u32 = 7_200;
-
-/// One file being written, opened on its first frame (which fixes labels, rate and the first
-/// frame number). A write error stops this file (logged once, reported when it is closed);
-/// what was written stays.
-#[derive(Debug)]
-struct Sink {
-    path: PathBuf,
-    labels: Vec<String>,
-    recorder: Option<Recorder>,
-    error: Option<String>,
-    gaps: Vec<bool>,
-    blank: Vec<f32>,
-}
-
-impl Sink {
-    fn new(path: PathBuf, labels: &[String]) -> Sink {
-        Sink {
-            path,
-            labels: labels.to_vec(),
-            recorder: None,
-            error: None,
-            gaps: vec![true; labels.len()],
-            blank: vec![0.0; labels.len() * 3],
-        }
-    }
-
-    /// Appends one frame, after `lost` all-missing rows.
-    fn push(&mut self, frame: (f64, i32, u32), xyz: &[f32], gaps: &[bool]) {
-        let (rate_hz, number, lost) = frame;
-        if self.error.is_some() || xyz.len() != self.labels.len() * 3 {
-            return;
-        }
-        if self.recorder.is_none() {
-            match Recorder::create(&self.path, self.labels.clone(), rate_hz, i64::from(number)) {
-                Ok(r) => self.recorder = Some(r),
-                Err(e) => return self.fail(&e),
-            }
-        } else if lost > MAX_FILL {
-            tracing::warn!(target: "emoshift", path = %self.path.display(), lost, "long pause not filled");
-        } else {
-            for _ in 0..lost {
-                if let Some(Err(e)) = self
-                    .recorder
-                    .as_mut()
-                    .map(|r| r.push_frame(&self.blank, &self.gaps))
-                {
-                    return self.fail(&e);
-                }
-            }
-        }
-        if let Some(Err(e)) = self.recorder.as_mut().map(|r| r.push_frame(xyz, gaps)) {
-            self.fail(&e);
-        }
-    }
-
-    fn fail(&mut self, e: &replay::WriteError) {
-        tracing::warn!(target: "emoshift", path = %self.path.display(), error = %e, "recording stopped");
-        self.error = Some(e.to_string());
-    }
-
-    /// Closes the file; frames written.
-    fn finish(self) -> Result<u64, RecordError> {
-        let write_error = |message: String| RecordError::Write {
-            path: self.path.display().to_string(),
-            message,
-        };
-        let frames = match self.recorder {
-            Some(r) => r.finish().map_err(|e| write_error(e.to_string()))?.frames,
-            None => 0,
-        };
-        tracing::info!(target: "emoshift", path = %self.path.display(), frames, "recording closed");
-        match self.error {
-            Some(e) => Err(write_error(format!("stopped after {frames} frames: {e}"))),
-            None => Ok(frames),
-        }
-    }
 }
 
 /// One stream's files.
@@ -291,11 +210,12 @@ impl Recording {
             }
             None => self.open(e),
         };
-        let frame = (
-            e.rate_hz,
-            e.frame_number,
-            e.frames_since_last.saturating_sub(1),
-        );
+        let frame = Frame {
+            rate_hz: e.rate_hz,
+            number: e.frame_number,
+            lost: e.frames_since_last.saturating_sub(1),
+            timecode: e.time.timecode.as_ref(),
+        };
         if self.no_gaps.len() < e.labels.len() {
             self.no_gaps.resize(e.labels.len(), false);
         }

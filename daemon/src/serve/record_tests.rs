@@ -61,7 +61,16 @@ fn emitted<'a>(
         input_labels: labels,
         labels,
         rate_hz: 60.0,
+        time: no_time(),
     }
+}
+
+fn no_time() -> &'static protocol::FrameTime {
+    static TIME: protocol::FrameTime = protocol::FrameTime {
+        timecode: None,
+        clock: protocol::CaptureClock::Source,
+    };
+    &TIME
 }
 
 #[test]

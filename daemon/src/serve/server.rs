@@ -46,6 +46,8 @@ pub struct Bound {
     config: Config,
     model: Arc<IcaModel>,
     performers: Vec<Performer>,
+    /// The NatNet source's sockets, when one is configured.
+    natnet: Option<super::natnet::Link>,
 }
 
 /// Binds both sockets and loads the models, so that a test learns the addresses before frames
@@ -83,6 +85,11 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
     let control = UdpSocket::bind(config.control)
         .await
         .with_context(|| format!("binding the control socket {}", config.control))?;
+    let natnet = config
+        .natnet
+        .clone()
+        .map(super::natnet::Link::open)
+        .transpose()?;
     Ok(Bound {
         frames,
         replies,
@@ -90,6 +97,7 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
         config,
         model,
         performers,
+        natnet,
     })
 }
 
@@ -164,6 +172,15 @@ impl Bound {
             },
         )?;
         let processing = tracker.spawn_blocking(move || processing.run());
+        if let Some(link) = self.natnet {
+            let queue = queue.clone();
+            tracker.spawn(super::natnet::source::run(
+                link,
+                queue,
+                Arc::clone(&stats),
+                shutdown.clone(),
+            ));
+        }
         tracker.spawn(receive(frames, queue, admission, shutdown.clone()));
         tracker.spawn(control::run(ctx.clone(), shutdown.clone()));
         tracker.spawn(control::reload_on_sighup(ctx, shutdown.clone()));
@@ -199,8 +216,9 @@ fn processing_thread(
     ))
 }
 
-/// The processing queue's ends as the receive task uses them.
-struct Queue {
+/// The processing queue's ends as a receiving task uses them.
+#[derive(Clone)]
+pub(super) struct Queue {
     tx: Sender<InFrame>,
     /// To drop the oldest frame when full.
     rx: Receiver<InFrame>,
@@ -224,12 +242,6 @@ async fn receive(
     admission: Admission,
     shutdown: CancellationToken,
 ) {
-    let Queue {
-        tx,
-        rx,
-        free,
-        dropped,
-    } = queue;
     let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
     loop {
         let (len, peer) = tokio::select! {
@@ -247,24 +259,41 @@ async fn receive(
             admission.refused.fetch_add(1, Ordering::Relaxed);
             continue;
         }
-        let mut bytes = free.try_recv().unwrap_or_default();
-        bytes.clear();
+        let mut bytes = queue.buffer();
         bytes.extend_from_slice(&buf[..len]);
-        let mut item = InFrame {
+        let item = InFrame {
             peer,
             bytes,
             received: Instant::now(),
+            natnet: None,
         };
+        if !queue.push(item) {
+            return;
+        }
+    }
+}
+
+impl Queue {
+    /// An empty buffer for a datagram: a pooled one handed back by the processing thread.
+    pub(super) fn buffer(&self) -> Vec<u8> {
+        let mut bytes = self.free.try_recv().unwrap_or_default();
+        bytes.clear();
+        bytes
+    }
+
+    /// Queues `item` for the processing thread, dropping (and counting) the oldest frame
+    /// when full: latest frame wins. `false` once the processing thread is gone.
+    pub(super) fn push(&self, mut item: InFrame) -> bool {
         loop {
-            match tx.try_send(item) {
-                Ok(()) => break,
+            match self.tx.try_send(item) {
+                Ok(()) => return true,
                 Err(crossbeam_channel::TrySendError::Full(back)) => {
                     item = back;
-                    if rx.try_recv().is_ok() {
-                        dropped.fetch_add(1, Ordering::Relaxed);
+                    if self.rx.try_recv().is_ok() {
+                        self.dropped.fetch_add(1, Ordering::Relaxed);
                     }
                 }
-                Err(crossbeam_channel::TrySendError::Disconnected(_)) => return,
+                Err(crossbeam_channel::TrySendError::Disconnected(_)) => return false,
             }
         }
     }

@@ -71,6 +71,11 @@ pub struct Stats {
     pub control_refused: u64,
     /// Frames from sources outside `frames_allow`.
     pub dropped_not_allowed: u64,
+    /// The NatNet source, when one is configured.
+    pub natnet: Option<super::natnet::NatNetStatus>,
+    /// Per stream id: end-to-end latency from the source's capture time (NatNet: camera
+    /// mid-exposure, through the echo's clock offset; OSC: a UTC capture time), µs.
+    pub stream_latency_us: Vec<(i32, Histogram<u64>)>,
 }
 
 impl Default for Stats {
@@ -101,6 +106,8 @@ impl Stats {
             model: String::new(),
             control_refused: 0,
             dropped_not_allowed: 0,
+            natnet: None,
+            stream_latency_us: Vec::new(),
         }
     }
 
@@ -130,6 +137,7 @@ impl Stats {
             ("restarts", c.restarts),
             ("model_swaps", c.model_swaps),
             ("bad_packets", c.bad_total()),
+            ("bad_natnet", c.bad_natnet),
             ("control_refused", self.control_refused),
             ("datagrams_sent", self.send.datagrams_sent),
             ("send_errors", self.send.send_errors),
@@ -151,8 +159,17 @@ impl Stats {
         for st in &self.per_stream {
             stream_pairs(st, &mut out);
         }
+        for (id, h) in &self.stream_latency_us {
+            for (q, label) in [(0.5, "p50"), (0.99, "p99")] {
+                let name = format!("stream/{id}/latency_{label}_us");
+                out.push((name, int(h.value_at_quantile(q))));
+            }
+        }
         for (n, sub) in self.subscribers.iter().enumerate() {
             subscriber_pairs(n, sub, &mut out);
+        }
+        if let Some(n) = &self.natnet {
+            out.extend(n.pairs());
         }
         for (name, h) in [("processed", &self.processed_us), ("sent", &self.sent_us)] {
             for (q, label) in [(0.5, "p50"), (0.99, "p99"), (0.999, "p999")] {

@@ -54,6 +54,58 @@ pub fn read(mut input: impl Read) -> Result<Take, ReadError> {
     read_with_info(&bytes).map(|(take, _)| take)
 }
 
+/// The timecode and camera rate a C3D file stores: the first frame's timecode from Vicon's
+/// TIMECODE group (its exact rate from `TIMECODE:RATE` when emoshift wrote it, else from
+/// STANDARD and DROP_FRAMES), and `TRIAL:CAMERA_RATE`. `None` fields where the file has none.
+///
+/// # Errors
+/// As [`read`], for the header and parameter section.
+pub fn read_time(bytes: &[u8]) -> Result<crate::record::RecordTime, ReadError> {
+    let (processor, header) = binary::parse_header(bytes)?;
+    let params = params::parse(bytes, header.parameter_block, header.data_block, processor)?;
+    let camera_rate_hz = params.number("TRIAL", "CAMERA_RATE", false);
+    let used = params.number("TIMECODE", "USED", false).unwrap_or(0.0) >= 1.0;
+    let hmsf = params
+        .numbers("TIMECODE", "TIMECODES", false)
+        .filter(|v| v.len() == 4);
+    let timecode = match (used, hmsf) {
+        (true, Some(v)) => {
+            let drop_frame = params.number("TIMECODE", "DROP_FRAMES", false) == Some(1.0);
+            let fps = params
+                .number("TIMECODE", "RATE", false)
+                .filter(|r| *r > 0.0)
+                .or_else(|| {
+                    let standard = params.strings("TIMECODE", "STANDARD")?;
+                    match standard.first()?.as_str() {
+                        "NTSC" if drop_frame => Some(29.97),
+                        "NTSC" => Some(30.0),
+                        "PAL" => Some(25.0),
+                        "FILM" => Some(24.0),
+                        other => other.parse().ok(),
+                    }
+                });
+            let rate = fps.and_then(|f| {
+                let text = format!("{f:.3}{}", if drop_frame { "df" } else { "" });
+                protocol::TimecodeRate::parse(&text).ok()
+            });
+            let sub = params.number("TIMECODE", "OFFSETS", false).unwrap_or(0.0);
+            Some(protocol::Smpte {
+                hours: v[0] as u8,
+                minutes: v[1] as u8,
+                seconds: v[2] as u8,
+                frames: v[3] as u8,
+                subframe: sub as u32,
+                rate,
+            })
+        }
+        _ => None,
+    };
+    Ok(crate::record::RecordTime {
+        timecode,
+        camera_rate_hz,
+    })
+}
+
 /// Reads a C3D take from bytes and reports how it was decoded.
 ///
 /// # Errors

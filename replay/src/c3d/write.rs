@@ -46,6 +46,7 @@ pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
     let meta = Meta {
         labels: &take.labels,
         rate_hz: take.rate_hz,
+        time: None,
     };
     let blocks = parameter_blocks(&meta, &range)?;
     out.write_all(&head(&meta, &range, blocks))?;
@@ -64,6 +65,8 @@ pub(crate) struct Meta<'a> {
     pub(crate) labels: &'a [String],
     /// Frame rate, Hz.
     pub(crate) rate_hz: f64,
+    /// A recording's timecode and measured rate.
+    pub(crate) time: Option<&'a crate::record::RecordTime>,
 }
 
 /// Rejects labels C3D cannot hold: too many markers, a label over 255 bytes.
@@ -210,6 +213,9 @@ fn header(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> [u8; BLOCK] {
     h
 }
 
+#[path = "write_timecode.rs"]
+mod timecode;
+
 /// Group ids.
 const POINT: i8 = 1;
 const ANALOG: i8 = 2;
@@ -256,6 +262,12 @@ fn parameters(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> Vec<u8> {
     let words = |v: u32| [(v & 0xFFFF) as u16, (v >> 16) as u16];
     w.int(TRIAL, "ACTUAL_START_FIELD", &words(range.first));
     w.int(TRIAL, "ACTUAL_END_FIELD", &words(range.last));
+    if let Some(rate) = meta.time.and_then(|t| t.camera_rate_hz) {
+        w.float(TRIAL, "CAMERA_RATE", &[rate as f32]);
+    }
+    if let Some(tc) = meta.time.and_then(|t| t.timecode) {
+        timecode::group(&mut w, &tc, meta.rate_hz);
+    }
     w.finish()
 }
 
@@ -353,6 +365,7 @@ mod tests {
         let meta = Meta {
             labels: &take.labels,
             rate_hz: take.rate_hz,
+            time: None,
         };
         let mut params = parameters(&meta, &range, 3);
         // Append an EVENT group to the finished section: patch the last record's zero offset.

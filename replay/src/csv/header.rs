@@ -44,7 +44,8 @@ pub(crate) fn parse_comment(line: usize, text: &str, meta: &mut Meta) -> Result<
     Ok(())
 }
 
-/// Marker labels from `frame,time,<label>_x,<label>_y,<label>_z,...`.
+/// Marker labels from `frame,time,<label>_x,<label>_y,<label>_z,...`, and the number of extra
+/// columns between `time` and the markers (1 for a `timecode` column, else 0).
 ///
 /// Labels may contain underscores: each column is split at its last `_`. Cells are trimmed and
 /// may be wrapped in double quotes, as spreadsheets write them.
@@ -53,11 +54,20 @@ pub(crate) fn parse_comment(line: usize, text: &str, meta: &mut Meta) -> Result<
 /// [`ReadError::BadHeader`] when the line does not start `frame,time` or the marker columns are
 /// not a multiple of three; [`ReadError::BadCell`] naming the column whose label or axis suffix
 /// breaks the `_x`, `_y`, `_z` sequence.
-pub(crate) fn parse_header(line: usize, text: &str) -> Result<Vec<String>, ReadError> {
-    let cells: Vec<&str> = text.split(',').map(unquote).collect();
+pub(crate) fn parse_header(line: usize, text: &str) -> Result<(Vec<String>, usize), ReadError> {
+    let mut cells: Vec<&str> = text.split(',').map(unquote).collect();
     let starts_right = cells.len() >= 2
         && cells[0].eq_ignore_ascii_case("frame")
         && cells[1].eq_ignore_ascii_case("time");
+    // A live recording's `timecode` column (issue 16) comes right after `time`.
+    let extra = usize::from(
+        cells
+            .get(2)
+            .is_some_and(|c| c.eq_ignore_ascii_case("timecode")),
+    );
+    if extra == 1 {
+        cells.remove(2);
+    }
     if !starts_right || (cells.len() - 2) % 3 != 0 {
         return Err(ReadError::BadHeader {
             line,
@@ -77,7 +87,7 @@ pub(crate) fn parse_header(line: usize, text: &str) -> Result<Vec<String>, ReadE
             if !ok {
                 return Err(ReadError::BadCell {
                     line,
-                    column: 3 + 3 * m + axis,
+                    column: 3 + extra + 3 * m + axis,
                     field: "header".to_owned(),
                     expected: [
                         "`<label>_x`",
@@ -93,7 +103,7 @@ pub(crate) fn parse_header(line: usize, text: &str) -> Result<Vec<String>, ReadE
         }
         labels.push(label.to_owned());
     }
-    Ok(labels)
+    Ok((labels, extra))
 }
 
 /// A header cell without surrounding spaces or double quotes.
@@ -116,12 +126,17 @@ mod tests {
             "frame,time,Lip_Upper_x,Lip_Upper_y,Lip_Upper_z,Chin_X,Chin_Y,Chin_Z",
         )
         .unwrap();
-        assert_eq!(labels, ["Lip_Upper", "Chin"]);
+        assert_eq!(
+            labels,
+            (vec!["Lip_Upper".to_string(), "Chin".to_string()], 0)
+        );
         let quoted = parse_header(
             1,
             "\"frame\", \"time\", \"Brow L_x\",\"Brow L_y\",\"Brow L_z\"",
         );
-        assert_eq!(quoted.unwrap(), ["Brow L"]);
+        assert_eq!(quoted.unwrap().0, ["Brow L"]);
+        let timed = parse_header(1, "frame,time,timecode,A_x,A_y,A_z").unwrap();
+        assert_eq!(timed, (vec!["A".to_string()], 1));
     }
 
     #[test]

@@ -49,7 +49,7 @@ use crate::{Take, Units};
 pub fn read(input: impl Read) -> Result<Take, ReadError> {
     let mut lines = Lines::new(BufReader::new(input));
     let mut meta = Meta::default();
-    let labels = loop {
+    let (labels, extra) = loop {
         let line = lines.next_number();
         match lines.next_non_blank()? {
             Some((n, text)) if text.trim_start().starts_with('#') => {
@@ -65,7 +65,7 @@ pub fn read(input: impl Read) -> Result<Take, ReadError> {
     let units = meta.units.unwrap_or(Units::Millimetres);
     let mut take = Take::new(labels, meta.rate_hz.unwrap_or(1.0), 1);
     take.source_units = units;
-    let rows = read_rows(&mut lines, &mut take, meta.rate_hz.is_none())?;
+    let rows = read_rows(&mut lines, &mut take, meta.rate_hz.is_none(), extra)?;
     if let Some(first) = rows.first_frame {
         take.first_frame = first;
     }
@@ -90,9 +90,10 @@ fn read_rows<R: std::io::BufRead>(
     lines: &mut Lines<R>,
     take: &mut Take,
     keep_times: bool,
+    extra: usize,
 ) -> Result<Rows, ReadError> {
     let n = take.n_markers();
-    let width = 2 + 3 * n;
+    let width = 2 + extra + 3 * n;
     let scale = f64::from(take.source_units.to_mm());
     let (mut xyz, mut gone) = (vec![0.0f32; 3 * n], vec![false; n]);
     let mut rows = Rows {
@@ -125,8 +126,8 @@ fn read_rows<R: std::io::BufRead>(
         }
         text::parse_samples(
             line,
-            &cells[2..],
-            2,
+            &cells[2 + extra..],
+            2 + extra,
             &take.labels,
             scale,
             &mut xyz,

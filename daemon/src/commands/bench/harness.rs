@@ -71,16 +71,7 @@ pub(super) async fn through_daemon(
     poll_window_us: u64,
 ) -> Result<Run> {
     let (receivers, addrs) = receivers(clients).await?;
-    let mut raw = RawConfig {
-        listen: Some("127.0.0.1:0".into()),
-        control: Some("127.0.0.1:0".into()),
-        model: Some("unused".into()),
-        queue: Some(1024),
-        poll_window_us: Some(poll_window_us),
-        stats_interval_s: Some(3600.0),
-        ..RawConfig::default()
-    };
-    raw.send = addrs.iter().map(|a| a.to_string()).collect();
+    let raw = daemon_config(&addrs, poll_window_us);
     let daemon = Daemon::start_with(raw.validate()?, model.clone()).await?;
     let traffic = async {
         let sent = send_all(model, performers, daemon.frames, rate_hz, secs).await?;
@@ -97,6 +88,20 @@ pub(super) async fn through_daemon(
         sent,
         status,
     })
+}
+
+/// The bench daemon's config: loopback, sending to `receivers`, a long queue, quiet logs.
+pub(super) fn daemon_config(receivers: &[SocketAddr], poll_window_us: u64) -> RawConfig {
+    RawConfig {
+        listen: Some("127.0.0.1:0".into()),
+        control: Some("127.0.0.1:0".into()),
+        model: Some("unused".into()),
+        queue: Some(1024),
+        poll_window_us: Some(poll_window_us),
+        stats_interval_s: Some(3600.0),
+        send: receivers.iter().map(|a| a.to_string()).collect(),
+        ..RawConfig::default()
+    }
 }
 
 /// The same traffic through a minimal relay: one thread, blocking receive, the same bytes
@@ -134,9 +139,9 @@ pub(super) async fn through_relay(
     Ok(collect(receivers).await)
 }
 
-type Receivers = Vec<Collecting<Seen>>;
+pub(super) type Receivers = Vec<Collecting<Seen>>;
 
-async fn receivers(k: usize) -> Result<(Receivers, Vec<SocketAddr>)> {
+pub(super) async fn receivers(k: usize) -> Result<(Receivers, Vec<SocketAddr>)> {
     let mut out = Vec::with_capacity(k);
     let mut addrs = Vec::with_capacity(k);
     for _ in 0..k {
@@ -159,7 +164,7 @@ fn time_frame(seen: &mut Seen, r: &Received<'_>) {
     }
 }
 
-async fn collect(receivers: Receivers) -> Seen {
+pub(super) async fn collect(receivers: Receivers) -> Seen {
     let mut all = Seen::new();
     for r in receivers {
         if let Ok(s) = r.stop().await {
@@ -170,7 +175,7 @@ async fn collect(receivers: Receivers) -> Seen {
 }
 
 /// The bench's clock, shared by senders and receivers.
-fn epoch() -> Instant {
+pub(super) fn epoch() -> Instant {
     static EPOCH: OnceLock<Instant> = OnceLock::new();
     *EPOCH.get_or_init(Instant::now)
 }

@@ -8,9 +8,15 @@
 //!    where frames went (from `/status`).
 //! 3. One processing thread: frames through [`Pipeline`] back to back (109 markers, m = 20).
 //!
+//! With `--natnet`, NatNet sources join the paced rounds: the same performers as markersets
+//! of a Motive stand-in's NatNet stream ([`natnet`]), multicast (Motive's default; the kernel's
+//! multicast loopback is part of the path) and unicast, each compared with the OSC source
+//! measured in the same run.
+//!
 //! Bounded in time, only 127.0.0.1.
 
 mod harness;
+mod natnet;
 
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -48,16 +54,30 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let rounds = (args.seconds / ROUND.as_secs_f64()).ceil().max(1.0) as u32;
     let per_round = Duration::from_secs_f64(args.seconds) / rounds;
     let (n, k) = (args.performers, args.clients);
-    let (daemon, relay, max) = runtime.block_on(async {
+    let (daemon, relay, max, over_natnet) = runtime.block_on(async {
         let w = args.poll_window_us;
         let mut daemon = through_daemon(&model, n, k, 120.0, per_round, w).await?;
         let mut relay = through_relay(&model, n, k, per_round).await?;
-        for _ in 1..rounds {
-            daemon.add(through_daemon(&model, n, k, 120.0, per_round, w).await?);
-            relay.add(&through_relay(&model, n, k, per_round).await?);
+        let mut over_natnet: [Option<Run>; 2] = [None, None];
+        for round in 0..rounds {
+            for (multicast, all) in [true, false].into_iter().zip(over_natnet.iter_mut()) {
+                if !args.natnet {
+                    break;
+                }
+                let r =
+                    natnet::through_daemon_natnet(&model, (n, k), per_round, w, multicast).await?;
+                match all.as_mut() {
+                    None => *all = Some(r),
+                    Some(all) => Run::add(all, r),
+                }
+            }
+            if round + 1 < rounds {
+                daemon.add(through_daemon(&model, n, k, 120.0, per_round, w).await?);
+                relay.add(&through_relay(&model, n, k, per_round).await?);
+            }
         }
         let max = through_daemon(&model, 1, 1, MAX_RATE_HZ, Duration::from_secs(1), w).await?;
-        anyhow::Ok((daemon, relay, max))
+        anyhow::Ok((daemon, relay, max, over_natnet))
     })?;
     let sent = daemon.sent * k as u64;
     crate::out!(
@@ -90,11 +110,45 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
             d as f64 / r.max(1) as f64
         );
     }
+    for (nn, how) in over_natnet.iter().zip(["multicast", "unicast"]) {
+        if let Some(nn) = nn {
+            print_natnet(nn, how, (&daemon, &relay), k)?;
+        }
+    }
     print_max_rate(&max)?;
     let (per_frame_us, fps) = processing_rate(&model)?;
     crate::out!(
         "processing: {per_frame_us:.2} µs/frame median over batches, {fps:.0} frames/s on one thread"
     );
+    Ok(())
+}
+
+/// The NatNet rounds: loss, and added latency against the OSC rounds and the relay.
+fn print_natnet(
+    nn: &Run,
+    how: &str,
+    (osc, relay): (&Run, &harness::Seen),
+    clients: usize,
+) -> Result<()> {
+    let expected = nn.sent * clients as u64;
+    crate::out!(
+        "natnet (Motive stand-in, {how} on loopback): {} of {expected} datagrams received, \
+         {} lost; bad natnet datagrams (last round) {}",
+        nn.seen.received,
+        expected.saturating_sub(nn.seen.received),
+        nn.get("natnet/bad_datagrams"),
+    );
+    for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999), ("max", 1.0)] {
+        let n = nn.seen.latency_us.value_at_quantile(q);
+        let o = osc.seen.latency_us.value_at_quantile(q);
+        let r = relay.latency_us.value_at_quantile(q);
+        crate::out!(
+            "{label} added latency over natnet {how}: {n} µs (osc {o} µs, ratio {:.2}x; relay \
+             {r} µs, ratio {:.2}x)",
+            n as f64 / o.max(1) as f64,
+            n as f64 / r.max(1) as f64
+        );
+    }
     Ok(())
 }
 

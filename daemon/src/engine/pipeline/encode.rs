@@ -1,8 +1,8 @@
 //! Encoding a processed frame once per profile the subscribers want.
 
 use protocol::{
-    encode_compact_into, encode_components_into, FlatSplit, FrameBuf, Profile, StreamTag,
-    ETHERNET_PAYLOAD,
+    append_timecode_element, encode_compact_into, encode_components_into, FlatSplit, FrameBuf,
+    FrameTime, Profile, StreamTag, ETHERNET_PAYLOAD,
 };
 
 use crate::engine::edit_state::EditState;
@@ -49,15 +49,17 @@ impl Outputs {
     }
 
     /// Encodes `frame` once for each profile in `wanted`, with the stream's edit state (for
-    /// the compact state message), its components `u` and their VMC names.
+    /// the compact state message), its components `u` and their VMC names. The source's
+    /// `time` rides in the compact and components bundles as `/mocap/timecode` when there is
+    /// one (flat-split parts stay within their size budget without it).
     pub(super) fn encode(
         &mut self,
         wanted: ProfileMask,
         tag: &StreamTag<'_>,
         frame: &FrameBuf,
         edit: &EditState,
-        u: &[f32],
-        vmc: &[(String, usize)],
+        (u, vmc): (&[f32], &[(String, usize)]),
+        time: &FrameTime,
     ) -> Result<(), protocol::EncodeError> {
         self.compact.clear();
         self.components.clear();
@@ -65,9 +67,15 @@ impl Outputs {
         self.part_ends.clear();
         if wanted & profile_bit(Profile::Compact) != 0 {
             encode_compact_into(tag, frame, edit.target(), edit.amount(), &mut self.compact)?;
+            if time.is_some() {
+                append_timecode_element(time, &mut self.compact);
+            }
         }
         if wanted & profile_bit(Profile::Components) != 0 {
             encode_components_into(tag, u, vmc, &mut self.components)?;
+            if time.is_some() {
+                append_timecode_element(time, &mut self.components);
+            }
         }
         if wanted & profile_bit(Profile::FlatSplit) != 0 {
             for i in 0..self.split.part_count(frame.marker_count()) {

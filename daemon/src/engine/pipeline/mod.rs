@@ -10,8 +10,8 @@ use std::sync::Arc;
 
 use ica_core::model::IcaModel;
 use protocol::{
-    decode_frame_into, decode_labels, messages, Address, Control, DecodeError, FrameBuf,
-    LayoutBook, LayoutChange, Limits, Profile,
+    decode_frame_into, decode_labels, decode_timecode, messages, Address, Control, DecodeError,
+    FrameBuf, FrameTime, LayoutBook, LayoutChange, Limits, Profile,
 };
 
 use crate::engine::edit_state::{EditRefused, EditState};
@@ -20,12 +20,13 @@ use crate::engine::streams::{Performer, StreamKey, StreamStatus, Streams};
 use crate::engine::Counters;
 
 mod encode;
+mod natnet;
+mod run;
 mod setup;
 
 use encode::Outputs;
 pub use encode::{profile_bit, ProfileMask};
 pub use setup::apply_edit;
-use setup::new_stream;
 
 /// A source's datagram refused with a reason it should hear (`/emoshift/error` on the frame
 /// socket); the shell sends it, rate-limited.
@@ -107,6 +108,9 @@ pub struct Emitted<'a> {
     pub labels: &'a [String],
     /// The stream's model rate.
     pub rate_hz: f64,
+    /// The source's time of the frame: SMPTE timecode and capture clock (the capture time is
+    /// `input.header().capture_time_us`).
+    pub time: &'a FrameTime,
 }
 
 /// Pipeline settings.
@@ -140,6 +144,10 @@ pub struct Pipeline {
     limits: Limits,
     frame_in: FrameBuf,
     frame_out: FrameBuf,
+    /// The time of the frame being handled (from the datagram's `/mocap/timecode`).
+    time_in: FrameTime,
+    /// NatNet frames decoded here, reused.
+    natnet: natnet::NatNetInput,
     outputs: Outputs,
     wanted: ProfileMask,
     /// The last refusal the source should hear, taken by the shell after each datagram.
@@ -158,6 +166,8 @@ impl Pipeline {
             limits: Limits::default(),
             frame_in: FrameBuf::with_max_markers(config.max_markers),
             frame_out: FrameBuf::with_max_markers(config.max_markers),
+            time_in: FrameTime::default(),
+            natnet: natnet::NatNetInput::new(config.max_markers),
             outputs: Outputs::new(config.max_markers),
             wanted: profile_bit(Profile::Compact),
             refusal: None,
@@ -247,7 +257,8 @@ impl Pipeline {
         Ok(())
     }
 
-    /// Handles one received datagram; `emit` is called once per processed frame.
+    /// Handles one received datagram; `emit` is called once per processed frame. A
+    /// `/mocap/timecode` anywhere in the datagram is the time of its `/mocap/frame`.
     pub fn handle_datagram(
         &mut self,
         peer: SocketAddr,
@@ -261,10 +272,21 @@ impl Pipeline {
                 return;
             }
         };
+        self.time_in = FrameTime::default();
+        for msg in msgs.clone() {
+            if Address::parse(msg.address) == Some(Address::Timecode) {
+                match decode_timecode(msg.bytes) {
+                    Ok(t) => self.time_in = t,
+                    // The frame still goes through, without a time.
+                    Err(e) => self.counters.bad_packet(e.kind()),
+                }
+            }
+        }
         for msg in msgs {
             match Address::parse(msg.address) {
                 Some(Address::Frame) => self.handle_frame(peer, msg.bytes, emit),
                 Some(Address::Labels) => self.handle_labels(peer, msg.bytes),
+                Some(Address::Timecode) => {}
                 _ => self
                     .counters
                     .bad_packet(protocol::DecodeErrorKind::UnknownAddress),
@@ -304,7 +326,6 @@ impl Pipeline {
             Err(e) => return self.counters.bad_packet(e.kind()),
         };
         self.counters.frames_in += 1;
-        // The labels found here also go out with the frame (to the raw recording).
         let Some(labels) = self.layouts.layout_for(&peer, header.marker_count) else {
             return self.counters.dropped_no_layout += 1;
         };
@@ -312,53 +333,7 @@ impl Pipeline {
             source: peer,
             layout_id: labels.layout_id,
         };
-        let (performers, template) = (&self.performers, &self.template);
-        let (default_model, lowpass_s) = (&self.model, self.config.lowpass_s);
-        let Some(stream) = self.streams.get_or_create(key, |id| {
-            new_stream(
-                id,
-                &key,
-                &labels.names,
-                performers,
-                default_model,
-                template,
-                lowpass_s,
-            )
-        }) else {
-            return self.counters.dropped_unmatched += 1;
-        };
-        let counters = &mut self.counters;
-        let Some(done) = stream.process(&header, &self.frame_in, &mut self.frame_out, counters)
-        else {
-            return;
-        };
-        let (tag, edit) = (stream.identity.tag(), &stream.edit);
-        let (u, vmc) = (stream.components(), &stream.vmc);
-        let encoded = self
-            .outputs
-            .encode(self.wanted, &tag, &self.frame_out, edit, u, vmc);
-        if encoded.is_err() {
-            return self.counters.frame_errors += 1;
-        }
-        self.counters.frames_out += 1;
-        let out = &self.outputs;
-        emit(&Emitted {
-            key,
-            identity: &stream.identity,
-            labels_msg: stream.labels_msg(),
-            labels_due: done.labels_due,
-            frame_number: header.frame_number,
-            frames_since_last: done.frames_since_last,
-            compact: &out.compact,
-            parts: &out.parts,
-            part_ends: &out.part_ends,
-            components: &out.components,
-            xyz: stream.edited(),
-            input: &self.frame_in,
-            input_labels: &labels.names,
-            labels: stream.model.labels(),
-            rate_hz: stream.model.rate_hz(),
-        });
+        run::frame_step(run::step!(self), key, (&labels.names, None), &header, emit);
     }
 }
 

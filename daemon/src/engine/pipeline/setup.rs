@@ -9,37 +9,45 @@ use crate::engine::edit_state::EditRefused;
 use crate::engine::stream::{Identity, Stream};
 use crate::engine::streams::{Performer, StreamKey};
 
+/// What a new stream is made from besides its source: the performers, the default model and
+/// the settings its streams start with.
+pub(super) struct Defaults<'a> {
+    pub(super) performers: &'a [Performer],
+    pub(super) model: &'a Arc<IcaModel>,
+    pub(super) template: &'a crate::engine::edit_state::EditState,
+    pub(super) lowpass_s: f32,
+}
+
 /// A new stream `id` for `key` on its performer's model (or the default one, with the
-/// template's edit settings), named after its performer or its source; `None` when its labels
-/// share none with the model.
+/// template's edit settings), named after its performer, else `name` (a NatNet markerset),
+/// else its source; `None` when its labels share none with the model.
 pub(super) fn new_stream(
     id: i32,
     key: &StreamKey,
     source_labels: &[String],
-    performers: &[Performer],
-    default_model: &Arc<IcaModel>,
-    template: &crate::engine::edit_state::EditState,
-    lowpass_s: f32,
+    name: Option<&str>,
+    d: &Defaults<'_>,
 ) -> Option<Stream> {
-    let performer = performers.iter().position(|p| p.owns(key));
-    let p = performer.map(|i| &performers[i]);
+    let performer = d.performers.iter().position(|p| p.owns_stream(key, name));
+    let p = performer.map(|i| &d.performers[i]);
     let model = p
         .and_then(|p| p.model.clone())
-        .unwrap_or_else(|| Arc::clone(default_model));
-    let identity = match p {
-        Some(p) => Identity::new(id, &p.name),
-        None => Identity::new(id, &format!("{}/{}", key.source, key.layout_id)),
+        .unwrap_or_else(|| Arc::clone(d.model));
+    let identity = match (p, name) {
+        (Some(p), _) => Identity::new(id, &p.name),
+        (None, Some(name)) => Identity::new(id, name),
+        (None, None) => Identity::new(id, &format!("{}/{}", key.source, key.layout_id)),
     };
     let mut stream = Stream::new(
         identity,
         Arc::clone(&model),
         performer,
         source_labels,
-        lowpass_s,
+        d.lowpass_s,
     )
     .ok()?;
-    if Arc::ptr_eq(&model, default_model) {
-        stream.edit.copy_settings(template);
+    if Arc::ptr_eq(&model, d.model) {
+        stream.edit.copy_settings(d.template);
     }
     if let Some(p) = p {
         defaults_of(p, &mut stream);

@@ -191,3 +191,44 @@ fn frame_order_is_counted_per_stream() {
         .collect();
     assert_eq!(counts, vec![(a, 3, 0, 0), (b, 2, 1, 1)]);
 }
+
+/// Issue 16: a source's `/mocap/timecode` reaches the emitted frame and rides in the compact
+/// and components outputs; a frame without one has none.
+#[test]
+fn the_source_timecode_travels_with_its_frame() {
+    use protocol::{
+        decode_timecode, encode_frame_timed_into, CaptureClock, FrameTime, Smpte, TimecodeRate,
+    };
+    let model = Arc::new(random_model(MARKERS, 4, 5));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    p.set_wanted(profile_bit(Profile::Compact) | profile_bit(Profile::Components));
+    let mut xyz = vec![0.0; MARKERS * 3];
+    frame_into(&model, 0, &mut xyz);
+    let time = FrameTime {
+        timecode: Some(Smpte::from_frame_count(1_800, TimecodeRate::DF_29_97)),
+        clock: CaptureClock::Utc,
+    };
+    let mut buf = FrameBuf::with_max_markers(MARKERS);
+    buf.set_frame(1, 99, &xyz).expect("finite");
+    let mut timed = Vec::new();
+    encode_frame_timed_into(&buf, &time, &mut timed).expect("finite");
+    p.handle_datagram(peer(), &labels_datagram(&model, false), &mut |_| {});
+    let mut got = Vec::new();
+    for d in [timed, frame_datagram(&xyz, 2)] {
+        p.handle_datagram(peer(), &d, &mut |e| {
+            let carried = |bytes: &[u8]| {
+                messages(bytes, &protocol::Limits::default())
+                    .expect("well-formed")
+                    .find(|m| m.address == protocol::address::TIMECODE)
+                    .map(|m| decode_timecode(m.bytes).expect("valid"))
+            };
+            got.push((*e.time, carried(e.compact), carried(e.components)));
+        });
+    }
+    assert_eq!(got[0], (time, Some(time), Some(time)));
+    assert_eq!(got[1], (FrameTime::default(), None, None));
+    assert_eq!(
+        time.timecode.map(|t| t.to_string()).as_deref(),
+        Some("00:01:00;02.0")
+    );
+}

@@ -1,0 +1,87 @@
+//! `emoshift record`: a live source (an OSC frame socket or a NatNet server) captured to one
+//! file for training; Ctrl-C leaves the file complete. The capture is [`crate::serve::capture`].
+
+use anyhow::{Context, Result};
+use tokio_util::sync::CancellationToken;
+
+use crate::cli::RecordArgs;
+use crate::exit::UsageError;
+use crate::serve::capture::{self, CaptureConfig, Source};
+
+/// The arguments, checked.
+fn config(args: &RecordArgs) -> Result<CaptureConfig> {
+    let source = match (&args.listen, &args.natnet) {
+        (Some(l), None) => Source::Osc(
+            l.parse()
+                .map_err(|_| UsageError(format!("--listen: {l:?} is not an IP:PORT address")))?,
+        ),
+        (None, Some(server)) => {
+            let raw = args.natnet_options.raw(Some(server.clone()));
+            let n = raw.validate().map_err(|e| UsageError(e.to_string()))?;
+            Source::NatNet(n.expect("a server was given"))
+        }
+        _ => return Err(UsageError("give one source: --listen or --natnet".into()).into()),
+    };
+    if replay::Format::from_path(&args.out).is_none() {
+        return Err(UsageError(format!(
+            "--out {}: record to a .c3d, .trc or .csv file",
+            args.out.display()
+        ))
+        .into());
+    }
+    if args.frames == Some(0) || args.seconds.is_some_and(|s| !(s.is_finite() && s > 0.0)) {
+        return Err(UsageError("--frames and --seconds must be positive".into()).into());
+    }
+    crate::offline::output::check_out(&args.out, &[], args.force)?;
+    Ok(CaptureConfig {
+        source,
+        out: args.out.clone(),
+        frames: args.frames,
+        seconds: args.seconds,
+        performer: args.performer.clone(),
+    })
+}
+
+pub(crate) fn run(args: &RecordArgs) -> Result<()> {
+    let config = config(args)?;
+    let out = config.out.clone();
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the tokio runtime")?;
+    let captured = runtime.block_on(async move {
+        let shutdown = CancellationToken::new();
+        tokio::spawn(super::serve::cancel_on_signal(shutdown.clone()));
+        let mut notice = |line: &str| eprintln!("emoshift record: {line}");
+        capture::run(config, shutdown, &mut notice).await
+    })?;
+    let Some(c) = captured else {
+        crate::out!("no frames arrived; nothing written to {}", out.display());
+        return Ok(());
+    };
+    crate::out!(
+        "{}: {} frames of {} ({} markers), {} of them gaps; rate {} Hz ({})",
+        c.summary.path.display(),
+        c.summary.frames,
+        c.stream,
+        c.summary.markers,
+        c.gap_frames,
+        c.rate_hz,
+        match (c.announced_hz, c.measured_hz) {
+            (Some(a), Some(m)) => format!("announced {a}, measured {m:.3}"),
+            (Some(a), None) => format!("announced {a}"),
+            (None, Some(m)) => format!("measured {m:.3}"),
+            (None, None) => "assumed: too few frames to measure".into(),
+        }
+    );
+    if let Some(tc) = c.first_timecode {
+        crate::out!("  first timecode {tc}");
+    }
+    if !c.others.is_empty() {
+        crate::out!(
+            "  not recorded (pick one with --performer): {}",
+            c.others.join(", ")
+        );
+    }
+    Ok(())
+}
