@@ -43,6 +43,7 @@ mod counters;
 pub mod edit_state;
 pub mod frame;
 pub mod layout;
+pub mod monitor;
 pub mod pipeline;
 pub mod stream;
 pub mod streams;

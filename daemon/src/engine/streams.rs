@@ -152,6 +152,11 @@ impl Streams {
             .retain(|k, _| !(k.source == source && k.layout_id == layout_id));
     }
 
+    /// The stream of `key`, to read.
+    pub fn get(&self, key: &StreamKey) -> Option<&Stream> {
+        self.map.get(key)
+    }
+
     /// Every stream, to read.
     pub fn iter(&self) -> impl Iterator<Item = (&StreamKey, &Stream)> {
         self.map.iter()
