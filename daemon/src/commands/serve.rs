@@ -38,6 +38,9 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if let Some(l) = args.lowpass {
         raw.lowpass_s = Some(l);
     }
+    if let Some(m) = &args.monitor {
+        raw.monitor = Some(m.clone());
+    }
     raw.validate().map_err(|e| UsageError(e.to_string()).into())
 }
 

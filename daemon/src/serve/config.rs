@@ -81,6 +81,11 @@ pub struct RawConfig {
     pub max_model_mb: Option<u64>,
     /// Named performers.
     pub performers: Vec<RawPerformer>,
+    /// The monitor page's address (off when absent).
+    pub monitor: Option<String>,
+    /// The monitor page's token (generated and printed when the page is bound beyond
+    /// loopback and none is set).
+    pub monitor_token: Option<String>,
 }
 
 /// The validated configuration; the only form that travels on.
@@ -118,6 +123,10 @@ pub struct Config {
     pub max_model_bytes: u64,
     /// Performers.
     pub performers: Vec<PerformerConfig>,
+    /// The monitor page's address, if it is served.
+    pub monitor: Option<SocketAddr>,
+    /// The monitor page's token, if one is set.
+    pub monitor_token: Option<String>,
 }
 
 /// Why a configuration is refused; each names the key and the value.
@@ -237,6 +246,11 @@ impl RawConfig {
                 .into_iter()
                 .map(performer)
                 .collect::<Result<_, _>>()?,
+            monitor: self
+                .monitor
+                .map(|m| addr("monitor", Some(m), ""))
+                .transpose()?,
+            monitor_token: super::monitor::check_token(self.monitor_token)?,
         })
     }
 

@@ -12,6 +12,7 @@
 //! - [`arrival`]: when the processing thread polls instead of parking (a steady source's
 //!   beat);
 //! - [`record`]: recordings of the edited stream and the raw input;
+//! - [`monitor`]: the monitor page (HTTP + WebSocket), when `monitor` is set;
 //! - [`net`]: sockets (large receive buffers, connected senders).
 //!
 //! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
@@ -23,6 +24,7 @@ mod command;
 pub mod config;
 mod control;
 mod guard;
+pub mod monitor;
 pub mod net;
 mod processing;
 pub mod record;
