@@ -76,8 +76,9 @@ fn header_str<'a>(headers: &'a HeaderMap, name: header::HeaderName) -> Option<&'
     headers.get(name).and_then(|v| v.to_str().ok())
 }
 
-/// `Ok` when the request may be served; otherwise the answer it gets.
-fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri) -> Result<(), Response> {
+/// `Ok` when the request may be served; otherwise the answer it gets. A wrong token is counted
+/// as refused, and with `strict` (the WebSocket, which no first visit opens) a missing one too.
+fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Result<(), Response> {
     let host = header_str(headers, header::HOST);
     let cookie = header_str(headers, header::COOKIE);
     match m.access.check(host, uri.query(), cookie) {
@@ -94,9 +95,9 @@ fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri) -> Result<(), Response> {
             Err(secure(r, LOGIN_POLICY))
         }
         Verdict::Login { wrong } => {
-            if wrong {
+            if wrong || strict {
                 m.hub.refused.fetch_add(1, Ordering::Relaxed);
-                tracing::warn!(target: "emoshift", "monitor page: wrong token");
+                tracing::debug!(target: "emoshift", wrong, "monitor page: no or a wrong token");
             }
             let note = if wrong {
                 "That token is not this daemon's."
@@ -124,7 +125,7 @@ fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri) -> Result<(), Response> {
 
 /// One of the page's files.
 async fn file(State(m): State<Arc<Monitor>>, headers: HeaderMap, uri: Uri) -> Response {
-    if let Err(r) = gate(&m, &headers, &uri) {
+    if let Err(r) = gate(&m, &headers, &uri, false) {
         return r;
     }
     match FILES.iter().find(|(path, _, _)| *path == uri.path()) {
@@ -144,7 +145,7 @@ async fn ws(
     uri: Uri,
     upgrade: WebSocketUpgrade,
 ) -> Response {
-    if let Err(r) = gate(&m, &headers, &uri) {
+    if let Err(r) = gate(&m, &headers, &uri, true) {
         return r;
     }
     let host = header_str(&headers, header::HOST);
@@ -153,7 +154,7 @@ async fn ws(
         .origin_ok(host, header_str(&headers, header::ORIGIN))
     {
         m.hub.refused.fetch_add(1, Ordering::Relaxed);
-        tracing::warn!(target: "emoshift", %peer, "monitor WebSocket from a foreign origin refused");
+        tracing::debug!(target: "emoshift", %peer, "monitor WebSocket from a foreign origin refused");
         return (StatusCode::FORBIDDEN, "foreign origin\n").into_response();
     }
     if m.hub.full() {
