@@ -182,7 +182,7 @@ function connect() {
     state.connected = false;
     setLink("reconnecting", "bad");
     setTimeout(connect, backoff);
-    backoff = Math.min(backoff * 2, 5000);
+    backoff = Math.min(backoff * 2, 2000);
   };
 }
 
