@@ -8,6 +8,10 @@
 //!    where frames went (from `/status`).
 //! 3. One processing thread: frames through [`Pipeline`] back to back (109 markers, m = 20).
 //!
+//! With `--monitor IP:PORT`, every round also runs the daemon with the monitor page served
+//! there, once a browser shows it (the page reconnects to each round's daemon), and prints its
+//! latencies against the rounds without it.
+//!
 //! Bounded in time, only 127.0.0.1.
 
 mod harness;
@@ -23,7 +27,7 @@ use protocol::{encode_frame_into, FrameBuf};
 use crate::cli::BenchArgs;
 use crate::engine::pipeline::{Pipeline, PipelineConfig};
 use crate::synthetic::{frame_into, labels_datagram, random_model};
-use harness::{through_daemon, through_relay, Run};
+use harness::{through_daemon, through_relay, Run, Seen};
 
 const MARKERS: usize = 109;
 const COMPONENTS: usize = 20;
@@ -48,16 +52,28 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let rounds = (args.seconds / ROUND.as_secs_f64()).ceil().max(1.0) as u32;
     let per_round = Duration::from_secs_f64(args.seconds) / rounds;
     let (n, k) = (args.performers, args.clients);
-    let (daemon, relay, max) = runtime.block_on(async {
+    let monitor = args.monitor.as_deref();
+    let (daemon, watched, relay, max) = runtime.block_on(async {
         let w = args.poll_window_us;
-        let mut daemon = through_daemon(&model, n, k, 120.0, per_round, w).await?;
-        let mut relay = through_relay(&model, n, k, per_round).await?;
-        for _ in 1..rounds {
-            daemon.add(through_daemon(&model, n, k, 120.0, per_round, w).await?);
+        let mut daemon = through_daemon(&model, (n, k), 120.0, per_round, w, None).await?;
+        let mut watched = None;
+        let mut relay = Seen::new();
+        for round in 0..rounds {
+            if round > 0 {
+                daemon.add(through_daemon(&model, (n, k), 120.0, per_round, w, None).await?);
+            }
+            if monitor.is_some() {
+                let run = through_daemon(&model, (n, k), 120.0, per_round, w, monitor).await?;
+                match &mut watched {
+                    None => watched = Some(run),
+                    Some(all) => all.add(run),
+                }
+            }
             relay.add(&through_relay(&model, n, k, per_round).await?);
         }
-        let max = through_daemon(&model, 1, 1, MAX_RATE_HZ, Duration::from_secs(1), w).await?;
-        anyhow::Ok((daemon, relay, max))
+        let one = Duration::from_secs(1);
+        let max = through_daemon(&model, (1, 1), MAX_RATE_HZ, one, w, None).await?;
+        anyhow::Ok((daemon, watched, relay, max))
     })?;
     let sent = daemon.sent * k as u64;
     crate::out!(
@@ -90,11 +106,35 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
             d as f64 / r.max(1) as f64
         );
     }
+    if let Some(watched) = &watched {
+        print_watched(&daemon, watched, k)?;
+    }
     print_max_rate(&max)?;
     let (per_frame_us, fps) = processing_rate(&model)?;
     crate::out!(
         "processing: {per_frame_us:.2} µs/frame median over batches, {fps:.0} frames/s on one thread"
     );
+    Ok(())
+}
+
+/// The rounds with the monitor page open against the rounds without, same run.
+fn print_watched(daemon: &Run, watched: &Run, clients: usize) -> Result<()> {
+    crate::out!(
+        "with the monitor page open: {} of ~{} datagrams received; page feed dropped {}, \
+         snapshots unpublished {}",
+        watched.seen.received,
+        watched.sent * clients as u64,
+        watched.get("monitor_dropped"),
+        watched.get("monitor_unpublished"),
+    );
+    for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999)] {
+        let with = watched.seen.latency_us.value_at_quantile(q);
+        let without = daemon.seen.latency_us.value_at_quantile(q);
+        crate::out!(
+            "{label} added latency with the page open: {with} µs (without {without} µs, ratio {:.2}x)",
+            with as f64 / without.max(1) as f64
+        );
+    }
     Ok(())
 }
 

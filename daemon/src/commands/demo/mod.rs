@@ -130,7 +130,10 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
     let model = analyze_and_write(&model_path, &session.manifest, regions, &report)?;
     let take = Arc::new(crate::offline::load_take(&session.take)?);
     if let Some(addr) = &args.monitor {
-        step(4, "serving on loopback with the monitor page, the take looping")?;
+        step(
+            4,
+            "serving on loopback with the monitor page, the take looping",
+        )?;
         return monitor::serve(&model, take, addr);
     }
     step(4, "serving on loopback and replaying a take through it")?;
