@@ -279,6 +279,19 @@ def drops(driver, relay):
     check("and /status counts the same drops", dup and max(dup) >= read() - 5, (dup, read()))
 
 
+def recording(driver):
+    path = driver.find_element(By.ID, "rec-path")
+    path.clear()
+    path.send_keys("from-the-page.c3d")
+    driver.find_element(By.ID, "rec-start").click()
+    state = lambda: js(driver, "return document.getElementById('rec-state').textContent")
+    check("the page starts a recording and shows it", wait_for(lambda: "from-the-page.c3d" in state(), 5), state())
+    driver.find_element(By.ID, "rec-stop").click()
+    check("and stops it; the file is there", wait_for(lambda: state() == "idle", 5)
+          and wait_for(lambda: os.path.exists(f"{WORK}/from-the-page.c3d")
+                                  and os.path.getsize(f"{WORK}/from-the-page.c3d") > 1000, 5), state())
+
+
 def phone(driver):
     driver.set_window_size(390, 844)
     time.sleep(1.0)
@@ -304,7 +317,7 @@ def main():
         check("the OSC subscriber is confirmed and receives frames",
               wait_for(lambda: sub.confirmed and sub.frames > 10, 10))
         for step in (lambda: refusals(driver), lambda: views(driver), lambda: control(driver, sub),
-                     lambda: drops(driver, relay), lambda: phone(driver)):
+                     lambda: drops(driver, relay), lambda: recording(driver), lambda: phone(driver)):
             try:
                 step()
             except Exception as e:  # one broken step must not hide the others' results
