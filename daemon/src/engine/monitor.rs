@@ -93,7 +93,7 @@ impl Snapshot {
         for (i, &gone) in missing.iter().enumerate() {
             let filled = filled.get(i).copied().unwrap_or(gone);
             self.flags
-                .push(u8::from(gone) * FLAG_MISSING | u8::from(filled) * FLAG_FILLED);
+                .push((u8::from(gone) * FLAG_MISSING) | (u8::from(filled) * FLAG_FILLED));
         }
         let edit = &stream.edit;
         self.target.clear();

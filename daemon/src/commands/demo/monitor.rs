@@ -60,7 +60,7 @@ async fn looping(daemon: &Daemon, take: Arc<Take>) -> Result<()> {
     let sender = tokio::task::spawn_blocking(move || send_forever(&take, to, &stop2));
     let ended = tokio::select! {
         r = tokio::signal::ctrl_c() => r.context("cannot wait for Ctrl-C"),
-        r = async { sender.await } => match r {
+        r = sender => match r {
             Ok(Ok(())) => Ok(()),
             Ok(Err(e)) => Err(e),
             Err(e) => Err(anyhow::anyhow!("the sender panicked: {e}")),

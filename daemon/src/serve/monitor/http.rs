@@ -72,17 +72,18 @@ pub(crate) async fn serve(listener: TcpListener, m: Arc<Monitor>) {
     }
 }
 
-fn header_str<'a>(headers: &'a HeaderMap, name: header::HeaderName) -> Option<&'a str> {
+fn header_str(headers: &HeaderMap, name: header::HeaderName) -> Option<&str> {
     headers.get(name).and_then(|v| v.to_str().ok())
 }
 
-/// `Ok` when the request may be served; otherwise the answer it gets. A wrong token is counted
-/// as refused, and with `strict` (the WebSocket, which no first visit opens) a missing one too.
-fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Result<(), Response> {
+/// `None` when the request may be served; otherwise the answer it gets. A wrong token is
+/// counted as refused, and with `strict` (the WebSocket, which no first visit opens) a missing
+/// one too.
+fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Option<Response> {
     let host = header_str(headers, header::HOST);
     let cookie = header_str(headers, header::COOKIE);
     match m.access.check(host, uri.query(), cookie) {
-        Verdict::Allow => Ok(()),
+        Verdict::Allow => None,
         Verdict::SetCookie => {
             let mut r = (StatusCode::SEE_OTHER, [(header::LOCATION, uri.path())]).into_response();
             if let Some(c) = m
@@ -92,7 +93,7 @@ fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Result<(),
             {
                 r.headers_mut().insert(header::SET_COOKIE, c);
             }
-            Err(secure(r, LOGIN_POLICY))
+            Some(secure(r, LOGIN_POLICY))
         }
         Verdict::Login { wrong } => {
             if wrong || strict {
@@ -110,7 +111,7 @@ fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Result<(),
                 [(header::CONTENT_TYPE, HTML)],
                 body,
             );
-            Err(secure(r.into_response(), LOGIN_POLICY))
+            Some(secure(r.into_response(), LOGIN_POLICY))
         }
         Verdict::BadHost => {
             m.hub.refused.fetch_add(1, Ordering::Relaxed);
@@ -118,14 +119,14 @@ fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Result<(),
                 StatusCode::FORBIDDEN,
                 "this page answers to its own address only\n",
             );
-            Err(secure(r.into_response(), LOGIN_POLICY))
+            Some(secure(r.into_response(), LOGIN_POLICY))
         }
     }
 }
 
 /// One of the page's files.
 async fn file(State(m): State<Arc<Monitor>>, headers: HeaderMap, uri: Uri) -> Response {
-    if let Err(r) = gate(&m, &headers, &uri, false) {
+    if let Some(r) = gate(&m, &headers, &uri, false) {
         return r;
     }
     match FILES.iter().find(|(path, _, _)| *path == uri.path()) {
@@ -145,7 +146,7 @@ async fn ws(
     uri: Uri,
     upgrade: WebSocketUpgrade,
 ) -> Response {
-    if let Err(r) = gate(&m, &headers, &uri, true) {
+    if let Some(r) = gate(&m, &headers, &uri, true) {
         return r;
     }
     let host = header_str(&headers, header::HOST);
