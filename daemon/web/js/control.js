@@ -3,6 +3,7 @@
 // Every control goes out as the OSC message the control socket takes.
 
 import { encodeMessage } from "./osc.js";
+import { fit } from "./canvas.js";
 
 const $ = (id) => document.getElementById(id);
 const READ_ONLY = new Set(["/status", "/emotion/list"]);
@@ -94,16 +95,7 @@ export function createControl(send) {
 
   function drawMap(s) {
     if (!points.length) return;
-    const dpr = window.devicePixelRatio || 1;
-    const w = map.clientWidth;
-    const h = map.clientHeight;
-    if (map.width !== Math.round(w * dpr) || map.height !== Math.round(h * dpr)) {
-      map.width = Math.round(w * dpr);
-      map.height = Math.round(h * dpr);
-    }
-    const g = map.getContext("2d");
-    g.setTransform(dpr, 0, 0, dpr, 0, 0);
-    g.clearRect(0, 0, w, h);
+    const { g, w, h } = fit(map);
     const dims = points[0].level.length;
     const at = (v) => [v[0], dims > 1 ? v[1] : 0];
     const all = points.flatMap((p) => [at(p.level)]);

@@ -3,6 +3,7 @@
 // marked, and the marker under the pointer named.
 
 import { FLAG_MISSING, FLAG_FILLED } from "./feed.js";
+import { fit } from "./canvas.js";
 
 const COLORS = { input: "#7fb2ff", edited: "#f2a33a", miss: "#ff5d5d", fill: "#d77cff", grid: "#1d2530" };
 const AXES = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] };
@@ -95,17 +96,7 @@ export function createFace(els, redraw) {
   }
 
   function drawView(v, s) {
-    const c = v.canvas;
-    const dpr = window.devicePixelRatio || 1;
-    const w = c.clientWidth;
-    const h = c.clientHeight;
-    if (c.width !== Math.round(w * dpr) || c.height !== Math.round(h * dpr)) {
-      c.width = Math.round(w * dpr);
-      c.height = Math.round(h * dpr);
-    }
-    const g = c.getContext("2d");
-    g.setTransform(dpr, 0, 0, dpr, 0, 0);
-    g.clearRect(0, 0, w, h);
+    const { g, w, h } = fit(v.canvas);
     const snap = s.snap;
     const frame = s.frame;
     const scale = Math.min(w / (2.3 * frame.radius), h / (2.5 * frame.upExt));

@@ -1,21 +1,14 @@
 // The components over the last seconds: one lane per component, each scaled to its own range
 // in the window; the emotion components get taller lanes with the input beside the edit.
 
+import { fit } from "./canvas.js";
+
 export const HISTORY_S = 10;
 
 export function createStrip(canvas) {
   return {
     draw(s) {
-      const dpr = window.devicePixelRatio || 1;
-      const w = canvas.clientWidth;
-      const h = canvas.clientHeight;
-      if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
-        canvas.width = Math.round(w * dpr);
-        canvas.height = Math.round(h * dpr);
-      }
-      const g = canvas.getContext("2d");
-      g.setTransform(dpr, 0, 0, dpr, 0, 0);
-      g.clearRect(0, 0, w, h);
+      const { g, w, h } = fit(canvas);
       const hist = s.history;
       if (!hist.length) return;
       const m = hist[hist.length - 1].uOut.length;

@@ -23,6 +23,11 @@ const FILES: &[(&str, &str, &str)] = &[
     ("/style.css", CSS, include_str!("../../../web/style.css")),
     ("/js/main.js", JS, include_str!("../../../web/js/main.js")),
     ("/js/feed.js", JS, include_str!("../../../web/js/feed.js")),
+    (
+        "/js/canvas.js",
+        JS,
+        include_str!("../../../web/js/canvas.js"),
+    ),
     ("/js/osc.js", JS, include_str!("../../../web/js/osc.js")),
     ("/js/face.js", JS, include_str!("../../../web/js/face.js")),
     ("/js/strip.js", JS, include_str!("../../../web/js/strip.js")),
