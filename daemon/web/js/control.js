@@ -118,6 +118,7 @@ export function createControl(send) {
     g.font = "12px system-ui, sans-serif";
     g.textAlign = "center";
     const target = s && s.snap ? s.snap.target : "";
+    const placed = [];
     for (const p of points) {
       const [x, y] = layout(p.level);
       const rx = Math.max((p.spread[0] || 0) * scale, 5);
@@ -127,7 +128,13 @@ export function createControl(send) {
       g.strokeStyle = on ? "#37c6b4" : "#3a4452";
       g.beginPath(); g.ellipse(x, y, rx, ry, 0, 0, 2 * Math.PI); g.fill(); g.stroke();
       g.fillStyle = on ? "#bff3ea" : "#aeb6c2";
-      g.fillText(p.name, x, y - Math.max(ry, 5) - 5);
+      // Above the point, or below it when another label is already there.
+      const tw = g.measureText(p.name).width;
+      let ty = y - Math.max(ry, 5) - 5;
+      const clash = (yy) => placed.some((q) => Math.abs(q[0] - x) < (q[2] + tw) / 2 && Math.abs(q[1] - yy) < 13);
+      if (clash(ty)) ty = y + Math.max(ry, 5) + 14;
+      placed.push([x, ty, tw]);
+      g.fillText(p.name, x, ty);
     }
     if (s && s.level) {
       const [ix, iy] = layout(s.level.in);
