@@ -7,6 +7,8 @@ import { fit } from "./canvas.js";
 
 const $ = (id) => document.getElementById(id);
 const READ_ONLY = new Set(["/status", "/emotion/list"]);
+/** Writes text only when it changed: each write can relayout the page. */
+const setText = (el, text) => { if (el.textContent !== text) el.textContent = text; };
 /** Seconds of the page's own low-pass of the emotion levels drawn on the map. */
 const LEVEL_S = 1.0;
 
@@ -175,12 +177,12 @@ export function createControl(send) {
     },
     draw(s) {
       const snap = s.snap;
-      $("st-target").textContent = snap.target || "none";
-      $("st-amount").textContent = snap.amount === snap.amountGoal
+      setText($("st-target"), snap.target || "none");
+      setText($("st-amount"), snap.amount === snap.amountGoal
         ? snap.amount.toFixed(2)
-        : `${snap.amount.toFixed(2)} → ${snap.amountGoal.toFixed(2)}`;
-      $("st-ramp").textContent = `${snap.ramp.toFixed(2)} s`;
-      $("st-bypass").textContent = snap.bypass ? "on" : "off";
+        : `${snap.amount.toFixed(2)} → ${snap.amountGoal.toFixed(2)}`);
+      setText($("st-ramp"), `${snap.ramp.toFixed(2)} s`);
+      setText($("st-bypass"), snap.bypass ? "on" : "off");
       $("st-bypass").style.color = snap.bypass ? "var(--warn)" : "";
       $("bypass").setAttribute("aria-pressed", snap.bypass ? "true" : "false");
       for (const b of document.querySelectorAll(".emo-btn")) {

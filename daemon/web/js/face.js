@@ -52,10 +52,50 @@ function frameOf(snap, upChoice) {
   return { U, F, R, mean, radius, upExt };
 }
 
+/** Adds a circle of radius `r` around each point to the current path (one draw call for all). */
+function circles(g, points, r) {
+  g.beginPath();
+  for (const p of points) {
+    if (!p) continue;
+    g.moveTo(p[0] + r, p[1]);
+    g.arc(p[0], p[1], r, 0, 2 * Math.PI);
+  }
+}
+
+/** The edit as lines, the input as rings, the output as dots, gaps ringed: a few paths. */
+function drawMarkers(g, snap, pin, pout, k) {
+  g.strokeStyle = "rgba(242,163,58,.55)";
+  g.beginPath();
+  pin.forEach((p, i) => {
+    if (p) { g.moveTo(p[0], p[1]); g.lineTo(pout[i][0], pout[i][1]); }
+  });
+  g.stroke();
+  g.lineWidth = 1.5 * k;
+  g.strokeStyle = COLORS.input;
+  circles(g, pin, 4 * k);
+  g.stroke();
+  g.fillStyle = COLORS.edited;
+  circles(g, pout, 2.6 * k);
+  g.fill();
+  g.lineWidth = 1.8;
+  for (const [flag, color] of [[FLAG_MISSING, COLORS.miss], [FLAG_FILLED, COLORS.fill]]) {
+    // A missing marker is also filled: ring it once, red.
+    const ringed = pout.map((p, i) => {
+      const f = snap.flags[i];
+      const show = flag === FLAG_MISSING ? f & FLAG_MISSING : (f & FLAG_FILLED) && !(f & FLAG_MISSING);
+      return show ? p : null;
+    });
+    g.strokeStyle = color;
+    circles(g, ringed, 6.5 * k);
+    g.stroke();
+  }
+}
+
 export function createFace(els, redraw) {
   let yaw = 0;
   let stream = null;
-  let hoverAt = null; // { canvas, x, y }
+  let hoverAt = null; // { view, x, y, index }
+  let textAt = 0;
   const views = [
     { canvas: els.front, turn: 0, points: [] },
     { canvas: els.side, turn: Math.PI / 2, points: [] },
@@ -98,10 +138,8 @@ export function createFace(els, redraw) {
   function drawView(v, s) {
     const { g, w, h } = fit(v.canvas);
     const snap = s.snap;
-    const frame = s.frame;
-    const scale = Math.min(w / (2.3 * frame.radius), h / (2.5 * frame.upExt));
-    const cx = w / 2;
-    const cy = h / 2;
+    const scale = Math.min(w / (2.3 * s.frame.radius), h / (2.5 * s.frame.upExt));
+    const [cx, cy] = [w / 2, h / 2];
     // Markers shrink with the view, so a phone's small views stay readable.
     const k = Math.max(0.45, Math.min(1, w / 360));
     g.strokeStyle = COLORS.grid;
@@ -110,43 +148,20 @@ export function createFace(els, redraw) {
     g.moveTo(cx, 12); g.lineTo(cx, h - 12);
     g.moveTo(12, cy); g.lineTo(w - 12, cy);
     g.stroke();
-    const pin = [];
+    const at = (buf, i) => project(s.frame, buf.subarray(3 * i, 3 * i + 3), v.turn, scale, cx, cy);
     const pout = [];
+    const pin = [];
     for (let i = 0; i < snap.n; i++) {
-      const o = project(frame, snap.output.subarray(3 * i, 3 * i + 3), v.turn, scale, cx, cy);
-      pout.push(o);
-      const missing = snap.flags[i] & FLAG_MISSING;
-      pin.push(missing ? null : project(frame, snap.input.subarray(3 * i, 3 * i + 3), v.turn, scale, cx, cy));
+      pout.push(at(snap.output, i));
+      pin.push(snap.flags[i] & FLAG_MISSING ? null : at(snap.input, i));
     }
-    g.strokeStyle = "rgba(242,163,58,.55)";
-    g.beginPath();
-    for (let i = 0; i < snap.n; i++) {
-      if (!pin[i]) continue;
-      g.moveTo(pin[i][0], pin[i][1]);
-      g.lineTo(pout[i][0], pout[i][1]);
-    }
-    g.stroke();
-    g.lineWidth = 1.5 * k;
-    g.strokeStyle = COLORS.input;
-    for (const p of pin) {
-      if (!p) continue;
-      g.beginPath(); g.arc(p[0], p[1], 4 * k, 0, 2 * Math.PI); g.stroke();
-    }
-    g.fillStyle = COLORS.edited;
-    for (const p of pout) { g.beginPath(); g.arc(p[0], p[1], 2.6 * k, 0, 2 * Math.PI); g.fill(); }
-    for (let i = 0; i < snap.n; i++) {
-      const f = snap.flags[i];
-      if (!(f & (FLAG_MISSING | FLAG_FILLED))) continue;
-      g.strokeStyle = f & FLAG_MISSING ? COLORS.miss : COLORS.fill;
-      g.lineWidth = 1.8;
-      g.beginPath(); g.arc(pout[i][0], pout[i][1], 6.5 * k, 0, 2 * Math.PI); g.stroke();
-    }
+    drawMarkers(g, snap, pin, pout, k);
     v.points = pout;
     if (hoverAt && hoverAt.view === v && hoverAt.index !== undefined) {
-      const p = pout[hoverAt.index];
       g.strokeStyle = "#ffffff";
       g.lineWidth = 1.5;
-      g.beginPath(); g.arc(p[0], p[1], 8.5, 0, 2 * Math.PI); g.stroke();
+      circles(g, [pout[hoverAt.index]], 8.5);
+      g.stroke();
     }
   }
 
@@ -195,8 +210,13 @@ export function createFace(els, redraw) {
       }
       for (const v of views) drawView(v, s);
       els.title.textContent = s.name;
-      const missing = s.snap.flags.reduce((a, f) => a + (f & FLAG_MISSING ? 1 : 0), 0);
-      els.frameNo.textContent = `frame ${s.snap.frame} · ${s.snap.n} markers · ${missing} missing`;
+      // Text relayouts the page: four times a second is enough to read it.
+      const now = performance.now();
+      if (now - textAt >= 250) {
+        textAt = now;
+        const missing = s.snap.flags.reduce((a, f) => a + (f & FLAG_MISSING ? 1 : 0), 0);
+        els.frameNo.textContent = `frame ${s.snap.frame} · ${s.snap.n} markers · ${missing} missing`;
+      }
       if (hoverAt) showHover();
     },
   };

@@ -8,7 +8,7 @@ export const HISTORY_S = 10;
 export function createStrip(canvas) {
   return {
     draw(s) {
-      const { g, w, h } = fit(canvas);
+      const { g, w, h } = fit(canvas, "#151a21");
       const hist = s.history;
       if (!hist.length) return;
       const m = hist[hist.length - 1].uOut.length;
