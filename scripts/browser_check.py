@@ -247,6 +247,28 @@ def views(driver):
     driver.save_screenshot(f"{OUT}/monitor-desktop.png")
 
 
+def hover_and_rotate(driver):
+    """The marker under the pointer is named; the rotate control turns the views."""
+    canvas = driver.find_element(By.ID, "front")
+    x, y = js(driver, "return document.getElementById('front').markerPoints[0]")
+    w, h = canvas.size["width"], canvas.size["height"]
+    ActionChains(driver).move_to_element_with_offset(canvas, int(x - w / 2), int(y - h / 2)).perform()
+    label = js(driver, "const s = window.emoshift.streams.get(window.emoshift.selected);"
+                       "return s.model.labels[0];")
+    text = wait_for(lambda: js(driver, "const e = document.getElementById('hover');"
+                                       "return e.hidden ? '' : e.textContent"), 3)
+    check("the marker under the pointer is named", label and text.startswith(label), (label, text))
+    before = js(driver, "return document.getElementById('front').markerPoints.map(p => p[0])")
+    js(driver, "const r = document.getElementById('yaw'); r.value = '60';"
+               "r.dispatchEvent(new Event('input'))")
+    time.sleep(0.3)
+    after = js(driver, "return document.getElementById('front').markerPoints.map(p => p[0])")
+    moved = max(abs(a - b) for a, b in zip(before, after))
+    check("the rotate control turns the views", moved > 5, moved)
+    js(driver, "const r = document.getElementById('yaw'); r.value = '0';"
+               "r.dispatchEvent(new Event('input'))")
+
+
 def control(driver, sub):
     happy = driver.find_element(By.CSS_SELECTOR, '.emo-btn[data-emotion="happy"]')
     happy.click()
@@ -316,7 +338,8 @@ def main():
     try:
         check("the OSC subscriber is confirmed and receives frames",
               wait_for(lambda: sub.confirmed and sub.frames > 10, 10))
-        for step in (lambda: refusals(driver), lambda: views(driver), lambda: control(driver, sub),
+        for step in (lambda: refusals(driver), lambda: views(driver), lambda: hover_and_rotate(driver),
+                     lambda: control(driver, sub),
                      lambda: drops(driver, relay), lambda: recording(driver), lambda: phone(driver)):
             try:
                 step()

@@ -156,7 +156,9 @@ export function createFace(els, redraw) {
       pin.push(snap.flags[i] & FLAG_MISSING ? null : at(snap.input, i));
     }
     drawMarkers(g, snap, pin, pout, k);
+    // Kept for the pointer (and on the canvas element for scripts/browser-check).
     v.points = pout;
+    v.canvas.markerPoints = pout;
     if (hoverAt && hoverAt.view === v && hoverAt.index !== undefined) {
       g.strokeStyle = "#ffffff";
       g.lineWidth = 1.5;
