@@ -2,18 +2,23 @@
 //! markers and m = 20, through `Pipeline::handle_datagram`; budget 2 µs a frame (issue 7).
 //! Twice: the bare synthetic model (what `emoshift bench` measures), and the same model with
 //! both glitch checks on (a speed limit and per-marker bounds, as a trained model has), set
-//! loose enough that every sample passes, so the checks' full per-marker work is measured.
+//! loose enough that every sample passes, so the checks' full per-marker work is measured. And
+//! the bare model again with the monitor page open (issue 17): after each frame the processing
+//! thread's tap, at 120 Hz on a 30 Hz schedule, so every 4th frame is copied and published to
+//! the board, as `serve` does while a page is open; against the first line, its cost per frame.
 
 use std::net::SocketAddr;
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use daemon::engine::monitor::MonitorTap;
 use daemon::engine::pipeline::{Pipeline, PipelineConfig};
 use daemon::loopback::synthetic::{frame_into, labels_datagram, random_model};
+use daemon::serve::monitor::Board;
 use ica_core::model::{CaptureSettings, IcaModel, MarkerBounds};
 use protocol::{encode_frame_into, FrameBuf};
 
-fn bench_model(c: &mut Criterion, name: &str, model: IcaModel) {
+fn bench_model(c: &mut Criterion, name: &str, model: IcaModel, monitor: bool) {
     let model = Arc::new(model);
     let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
     let peer: SocketAddr = "127.0.0.1:9".parse().expect("literal address");
@@ -31,6 +36,8 @@ fn bench_model(c: &mut Criterion, name: &str, model: IcaModel) {
         })
         .collect();
     let mut n: i32 = 0;
+    let (board, mut tap) = (Board::new(), MonitorTap::new(30.0));
+    board.set_viewers(1);
     c.bench_function(name, |b| {
         b.iter(|| {
             let d = &mut datagrams[n as usize % 120];
@@ -38,10 +45,33 @@ fn bench_model(c: &mut Criterion, name: &str, model: IcaModel) {
             d[24..28].copy_from_slice(&n.to_be_bytes());
             n += 1;
             let mut out = 0;
-            pipeline.handle_datagram(peer, d, &mut |e| out += e.compact.len());
+            let mut last = None;
+            pipeline.handle_datagram(peer, d, &mut |e| {
+                out += e.compact.len();
+                last = Some(e.key);
+            });
+            if monitor && board.watched() {
+                let stream = last.and_then(|k| pipeline.stream(&k));
+                let now_us = n as u64 * 8_333;
+                if let Some(snap) = stream.and_then(|s| tap.handle_stream(now_us, s)) {
+                    board.publish(snap);
+                }
+            }
             out
         })
     });
+    if monitor {
+        // The tap's own work, every call due: one snapshot copied and published.
+        let key = pipeline.stream_status()[0].key;
+        let stream = pipeline.stream(&key).expect("the stream");
+        let mut now_us = 0u64;
+        c.bench_function("monitor tap: one snapshot, 109 markers m=20", |b| {
+            b.iter(|| {
+                now_us += 40_000;
+                tap.handle_stream(now_us, stream).map(|s| board.publish(s))
+            })
+        });
+    }
     let glitches = pipeline.counters.glitches;
     assert_eq!(
         glitches, 0,
@@ -54,6 +84,13 @@ fn whole_frame_path(c: &mut Criterion) {
         c,
         "pipeline 109 markers m=20 compact",
         random_model(109, 20, 1),
+        false,
+    );
+    bench_model(
+        c,
+        "pipeline 109 markers m=20 compact, monitor page open",
+        random_model(109, 20, 1),
+        true,
     );
     let mut checked = random_model(109, 20, 1);
     let centre = checked
@@ -76,6 +113,7 @@ fn whole_frame_path(c: &mut Criterion) {
         c,
         "pipeline 109 markers m=20 compact, glitch checks",
         checked,
+        false,
     );
 }
 

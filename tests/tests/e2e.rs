@@ -6,6 +6,7 @@ mod e2e {
     mod control;
     mod edit;
     mod faults;
+    mod monitor;
     mod natnet;
     mod shutdown;
     mod stage;

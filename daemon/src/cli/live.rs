@@ -26,6 +26,11 @@ pub struct ServeArgs {
     /// Low-pass window of the emotion edit, seconds [default: 1].
     #[arg(long)]
     pub lowpass: Option<f32>,
+    /// Serve the monitor page here (a browser shows the faces, the emotion control and the
+    /// health); loopback unless told otherwise. Beyond loopback it asks for a token.
+    #[arg(long, value_name = "IP:PORT", num_args = 0..=1,
+          default_missing_value = crate::serve::monitor::DEFAULT_MONITOR)]
+    pub monitor: Option<String>,
     /// Take frames from an OptiTrack Motive NatNet server too: its command channel,
     /// IP[:PORT] [port 1510]. Each markerset becomes a stream, beside the OSC frame socket.
     #[arg(long, value_name = "SERVER[:PORT]")]
@@ -83,6 +88,10 @@ pub struct BenchArgs {
     /// The daemon's `poll_window_us` (0: the processing thread always parks).
     #[arg(long, default_value_t = crate::serve::config::DEFAULT_POLL_WINDOW_US)]
     pub poll_window_us: u64,
+    /// Also run every daemon round with the monitor page served here, each once a browser
+    /// shows it (the rounds alternate with and without), and compare the latencies.
+    #[arg(long, value_name = "IP:PORT")]
+    pub monitor: Option<String>,
     /// Also feed the daemon from a NatNet server (a Motive stand-in on loopback, multicast),
     /// in rounds alternating with the OSC source and the relay: frames lost over NatNet, and
     /// its added latency against OSC's in the same run.
@@ -174,4 +183,9 @@ pub struct DemoArgs {
     /// Seed of the synthetic session.
     #[arg(long, default_value_t = 7)]
     pub seed: u64,
+    /// Serve the monitor page here and keep the daemon running with the take looping until
+    /// Ctrl-C (prints the page's URL).
+    #[arg(long, value_name = "IP:PORT", num_args = 0..=1,
+          default_missing_value = crate::serve::monitor::DEFAULT_MONITOR)]
+    pub monitor: Option<String>,
 }

@@ -50,6 +50,9 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
             *key = flag;
         }
     }
+    if let Some(m) = &args.monitor {
+        raw.monitor = Some(m.clone());
+    }
     raw.validate().map_err(|e| UsageError(e.to_string()).into())
 }
 

@@ -205,6 +205,21 @@ impl EditState {
         self.amount.value()
     }
 
+    /// The amount being glided to.
+    pub fn amount_goal(&self) -> f32 {
+        self.amount.goal()
+    }
+
+    /// The ramp of new settings, seconds.
+    pub fn ramp_s(&self) -> f32 {
+        self.ramp_s
+    }
+
+    /// Bypass is set (the edit glides out, or is out).
+    pub fn bypassed(&self) -> bool {
+        self.wet.goal() == 0.0
+    }
+
     /// Ramp used by the next settings.
     pub fn set_ramp(&mut self, ramp_s: f32) {
         self.ramp_s = ramp_s.max(0.0);

@@ -102,6 +102,11 @@ impl FramePrep {
         self.missing.len()
     }
 
+    /// The last prepared frame's missing mask: absent samples and rejected glitches.
+    pub fn missing(&self) -> &[bool] {
+        &self.missing
+    }
+
     /// Forgets the stream's history (glitch reference, held pose).
     pub fn reset(&mut self) {
         self.last_known.fill(false);
@@ -292,6 +297,11 @@ impl FrameProcessor {
     /// Components per frame.
     pub fn components(&self) -> usize {
         self.projector.components()
+    }
+
+    /// The markers the model filled in the last frame (absent or rejected as glitches).
+    pub fn filled(&self) -> &[bool] {
+        self.prep.missing()
     }
 
     /// Forgets the stream's history (glitch reference, held pose, held components).

@@ -49,6 +49,7 @@ mod counters;
 pub mod edit_state;
 pub mod frame;
 pub mod layout;
+pub mod monitor;
 pub mod natnet;
 pub mod pipeline;
 pub mod stream;

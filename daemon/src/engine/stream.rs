@@ -101,6 +101,8 @@ pub struct Stream {
     missing: Vec<bool>,
     /// Components.
     u: Vec<f32>,
+    /// Components before the edit (what the monitor page draws beside the edited ones).
+    u_in: Vec<f32>,
     /// Edited frame in model order.
     out: Vec<f32>,
     /// `/mocap/labels` of the output (model order, layout id = stream id); empty if a label
@@ -179,6 +181,7 @@ impl Stream {
             xyz: vec![0.0; n * 3],
             missing: vec![false; n],
             u: vec![0.0; m],
+            u_in: vec![0.0; m],
             out: vec![0.0; n * 3],
             vmc: vmc_names(&model),
             last_frame: None,
@@ -219,6 +222,31 @@ impl Stream {
     /// The source's labels, in the order of its frames.
     pub fn source_labels(&self) -> &[String] {
         &self.source_labels
+    }
+
+    /// The components of the last processed frame, before the edit.
+    pub fn components_in(&self) -> &[f32] {
+        &self.u_in
+    }
+
+    /// The last processed frame as received, in model order (markers the source lacks are 0).
+    pub fn input(&self) -> &[f32] {
+        &self.xyz
+    }
+
+    /// Which markers of the last frame were missing as received, model order.
+    pub fn input_missing(&self) -> &[bool] {
+        &self.missing
+    }
+
+    /// Which markers of the last frame the model filled (missing, or rejected as glitches).
+    pub fn filled(&self) -> &[bool] {
+        self.processor.filled()
+    }
+
+    /// The last frame number taken.
+    pub fn last_frame(&self) -> Option<i32> {
+        self.last_frame
     }
 
     /// The output's `/mocap/labels` (empty when a label cannot be sent).
@@ -282,6 +310,7 @@ impl Stream {
         let rate = self.model.rate_hz();
         // A gap of many frames moves the glides by at most a second.
         let dt = (f64::from(frames.min(rate.max(1.0) as u32)) / rate) as f32;
+        self.u_in.copy_from_slice(&self.u);
         self.edit.apply(dt, &mut self.u);
         let resynthesised =
             self.processor

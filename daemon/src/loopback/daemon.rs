@@ -18,6 +18,8 @@ pub struct Daemon {
     pub frames: SocketAddr,
     /// Where it receives control.
     pub control: SocketAddr,
+    /// Where it serves the monitor page, when `monitor` is set.
+    pub monitor: Option<SocketAddr>,
     shutdown: CancellationToken,
     done: Option<tokio::sync::oneshot::Receiver<Result<()>>>,
 }
@@ -51,10 +53,11 @@ impl Daemon {
                 let _ = done_tx.send(result);
             })
             .context("cannot start the daemon thread")?;
-        let (frames, control) = bound_rx.await.context("the daemon thread ended")??;
+        let (frames, control, monitor) = bound_rx.await.context("the daemon thread ended")??;
         Ok(Daemon {
             frames,
             control,
+            monitor,
             shutdown,
             done: Some(done),
         })
@@ -81,7 +84,7 @@ impl Drop for Daemon {
     }
 }
 
-type Bound = Result<(SocketAddr, SocketAddr)>;
+type Bound = Result<(SocketAddr, SocketAddr, Option<SocketAddr>)>;
 
 fn serve_until(
     config: Config,
@@ -102,7 +105,7 @@ fn serve_until(
         let addrs = bound
             .as_ref()
             .map_err(|e| anyhow::anyhow!("{e:#}"))
-            .and_then(|b| Ok((b.frame_addr()?, b.control_addr()?)));
+            .and_then(|b| Ok((b.frame_addr()?, b.control_addr()?, b.monitor_addr()?)));
         let _ = bound_tx.send(addrs);
         bound?.run(shutdown).await
     })

@@ -96,6 +96,11 @@ pub struct RawConfig {
     pub natnet_names: Option<String>,
     /// NatNet marker names (as built) to model labels.
     pub natnet_rename: HashMap<String, String>,
+    /// The monitor page's address (off when absent).
+    pub monitor: Option<String>,
+    /// The monitor page's token (generated and printed when the page is bound beyond
+    /// loopback and none is set).
+    pub monitor_token: Option<String>,
 }
 
 /// The validated configuration; the only form that travels on.
@@ -135,6 +140,10 @@ pub struct Config {
     pub performers: Vec<PerformerConfig>,
     /// The NatNet source, if any.
     pub natnet: Option<super::natnet::NatNetConfig>,
+    /// The monitor page's address, if it is served.
+    pub monitor: Option<SocketAddr>,
+    /// The monitor page's token, if one is set.
+    pub monitor_token: Option<String>,
 }
 
 /// Why a configuration is refused; each names the key and the value.
@@ -263,6 +272,11 @@ impl RawConfig {
                 rename: self.natnet_rename,
             }
             .validate()?,
+            monitor: self
+                .monitor
+                .map(|m| addr("monitor", Some(m), ""))
+                .transpose()?,
+            monitor_token: super::monitor::check_token(self.monitor_token)?,
         })
     }
 

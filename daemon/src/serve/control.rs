@@ -2,6 +2,9 @@
 //! recordings) to the processing thread, which applies them between frames, and answers each with
 //! `<address>/confirm` or `/emoshift/error`. Model loads run on a blocking thread; SIGHUP
 //! reloads the last model file.
+//!
+//! [`execute`] is the one command path: the control socket and the monitor page both call it
+//! once their guard admitted the message, so the two never disagree.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -12,7 +15,7 @@ use crossbeam_channel::Sender;
 use ica_core::model::IcaModel;
 use protocol::{
     encode_challenge_into, encode_confirm_into, encode_emotion_list_into, encode_error_into,
-    encode_status_into, Control, EmotionList,
+    encode_status_into, Control, EmotionList, StatusValue,
 };
 use tokio::net::UdpSocket;
 use tokio::sync::oneshot;
@@ -74,15 +77,11 @@ pub(crate) async fn run(ctx: ControlCtx, shutdown: CancellationToken) {
             send(&ctx, peer, &out).await;
             continue;
         }
-        if let Control::ModelLoad(path) = &control {
+        if let Control::ModelLoad(_) = &control {
             // Loading may take a while: answer from its own task, keep serving.
-            let (ctx2, path) = (ctx.clone(), PathBuf::from(path));
-            ctx.tracker.spawn(async move {
-                match reload(&ctx2, path).await {
-                    Ok(()) => confirm(&ctx2, peer, &control).await,
-                    Err(e) => reply(&ctx2, peer, protocol::address::MODEL_LOAD, Err(e)).await,
-                }
-            });
+            let ctx2 = ctx.clone();
+            ctx.tracker
+                .spawn(async move { handle(&ctx2, peer, control).await });
             continue;
         }
         handle(&ctx, peer, control).await;
@@ -114,45 +113,47 @@ fn refused_address(bytes: &[u8]) -> String {
         .unwrap_or_default()
 }
 
+/// What a control is answered with, whichever way it came.
+#[derive(Debug)]
+pub(crate) enum Answer {
+    /// Done (`<address>/confirm`).
+    Confirmed,
+    /// Refused, and why (`/emoshift/error`); already counted and logged.
+    Refused(Refusal),
+    /// `/status`: the counters.
+    Status(Vec<(String, StatusValue)>),
+    /// `/emotion/list`: the default model's emotion space.
+    EmotionList(EmotionList),
+}
+
+/// Answers a control over the control socket.
 async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
-    let address = control.address();
-    if control == Control::Status {
-        let pairs = ctx.stats.lock().map(|s| s.pairs()).unwrap_or_default();
-        let mut out = Vec::with_capacity(2048);
-        encode_status_into(&pairs, &mut out);
-        send(ctx, peer, &out).await;
-        return;
-    }
-    if control == Control::EmotionList {
-        let list = ctx.model.lock().map(|m| emotion_list(&m)).ok();
-        let mut out = Vec::with_capacity(2048);
-        match list {
-            Some(list) => {
-                encode_emotion_list_into(&list, &mut out);
-                send(ctx, peer, &out).await;
-            }
-            None => {
-                reply(
-                    ctx,
-                    peer,
-                    address,
-                    Err(Refusal::Model("model unavailable".into())),
-                )
-                .await
-            }
+    let mut out = Vec::with_capacity(2048);
+    match execute(ctx, peer, &control).await {
+        Answer::Confirmed => encode_confirm_into(&control, &mut out),
+        Answer::Refused(e) => encode_error_into(control.address(), &e.to_string(), &mut out),
+        Answer::Status(pairs) => encode_status_into(&pairs, &mut out),
+        Answer::EmotionList(list) => encode_emotion_list_into(&list, &mut out),
+    };
+    send(ctx, peer, &out).await;
+}
+
+/// Carries out a control the guard admitted (allow-list, secret, cookie): the one command
+/// path of the control socket and the monitor page. A refusal is counted and logged here.
+pub(crate) async fn execute(ctx: &ControlCtx, peer: SocketAddr, control: &Control) -> Answer {
+    let result = match control {
+        Control::Status => {
+            let pairs = ctx.stats.lock().map(|s| s.pairs()).unwrap_or_default();
+            return Answer::Status(pairs);
         }
-        return;
-    }
-    let result = match &control {
+        Control::EmotionList => match ctx.model.lock().map(|m| emotion_list(&m)) {
+            Ok(list) => return Answer::EmotionList(list),
+            Err(_) => Err(Refusal::Model("model unavailable".into())),
+        },
+        Control::ModelLoad(path) => reload(ctx, PathBuf::from(path)).await,
         Control::Subscribe { .. } | Control::Unsubscribe { .. } => {
-            ask(
-                ctx,
-                Command::Client {
-                    peer,
-                    control: control.clone(),
-                },
-            )
-            .await
+            let control = control.clone();
+            ask(ctx, Command::Client { peer, control }).await
         }
         Control::RecordStart {
             path,
@@ -160,12 +161,13 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
             overwrite,
         } => {
             let raw = raw.as_ref().map(PathBuf::from);
+            let (path, overwrite) = (PathBuf::from(path), *overwrite);
             ask(
                 ctx,
                 Command::RecordStart {
-                    path: PathBuf::from(path),
+                    path,
                     raw,
-                    overwrite: *overwrite,
+                    overwrite,
                 },
             )
             .await
@@ -174,8 +176,11 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
         other => ask(ctx, Command::Edit(other.clone())).await,
     };
     match result {
-        Ok(()) => confirm(ctx, peer, &control).await,
-        Err(e) => reply(ctx, peer, address, Err(e)).await,
+        Ok(()) => Answer::Confirmed,
+        Err(e) => {
+            count_refusal(ctx, peer, control.address(), &e);
+            Answer::Refused(e)
+        }
     }
 }
 
@@ -213,19 +218,18 @@ async fn reload(ctx: &ControlCtx, path: PathBuf) -> Reply {
     Ok(())
 }
 
-async fn confirm(ctx: &ControlCtx, peer: SocketAddr, control: &Control) {
-    let mut out = Vec::with_capacity(256);
-    encode_confirm_into(control, &mut out);
-    send(ctx, peer, &out).await;
+/// Counts a refused control (`control_refused`) and logs it, rate-limited.
+pub(crate) fn count_refusal(ctx: &ControlCtx, peer: SocketAddr, address: &str, e: &Refusal) {
+    if let Ok(mut s) = ctx.stats.lock() {
+        s.control_refused += 1;
+    }
+    ctx.guard.warn_refused(peer, address, e);
 }
 
 /// Sends the error reply of a refused message (`Ok` sends nothing).
 async fn reply(ctx: &ControlCtx, peer: SocketAddr, address: &str, r: Reply) {
     let Err(e) = r else { return };
-    if let Ok(mut s) = ctx.stats.lock() {
-        s.control_refused += 1;
-    }
-    ctx.guard.warn_refused(peer, address, &e);
+    count_refusal(ctx, peer, address, &e);
     let mut out = Vec::with_capacity(256);
     encode_error_into(address, &e.to_string(), &mut out);
     send(ctx, peer, &out).await;

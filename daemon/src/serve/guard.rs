@@ -54,6 +54,11 @@ impl Guard {
         }
     }
 
+    /// Whether mutating controls must carry the shared secret.
+    pub(crate) fn needs_secret(&self) -> bool {
+        self.secret.is_some()
+    }
+
     /// Whether `peer` may send control messages at all.
     ///
     /// # Errors

@@ -12,6 +12,7 @@
 //! - [`arrival`]: when the processing thread polls instead of parking (a steady source's
 //!   beat);
 //! - [`record`]: recordings of the edited stream and the raw input;
+//! - [`monitor`]: the monitor page (HTTP + WebSocket), when `monitor` is set;
 //! - [`net`]: sockets (large receive buffers, connected senders);
 //! - [`natnet`]: OptiTrack Motive's NatNet stream as a source beside the OSC frame socket;
 //! - [`capture`]: `emoshift record`, a live source (OSC or NatNet) captured to one file.
@@ -27,6 +28,7 @@ pub mod config;
 mod control;
 mod guard;
 mod latency;
+pub mod monitor;
 pub mod natnet;
 pub mod net;
 pub(crate) mod processing;

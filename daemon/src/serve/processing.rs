@@ -14,6 +14,7 @@ use crossbeam_channel::{Receiver, Sender};
 
 use super::arrival::{ArrivalClock, SpinWindow, Wait};
 use super::command::{Command, Refusal, Reply, Request};
+use super::monitor::Feed;
 use super::record::{close_in_background, finish_recording, RecordError, Recording};
 use super::sender::Fanout;
 use super::stats::{Stats, SubscriberStatus};
@@ -63,6 +64,8 @@ pub(crate) struct Shared {
     pub(crate) not_allowed: Arc<AtomicU64>,
     /// The frame socket, to tell a source why its datagram was refused (`None` in tests).
     pub(crate) replies: Option<std::net::UdpSocket>,
+    /// The monitor page's feed, when the page is served.
+    pub(crate) monitor: Option<Feed>,
 }
 
 /// What the processing thread does while its queue is empty.
@@ -101,6 +104,7 @@ pub(crate) struct Processing {
     processed_us: hdrhistogram::Histogram<u64>,
     /// Per stream id, capture → processed (see [`super::latency`]).
     latency: super::latency::StreamLatency,
+    monitor: Option<Feed>,
 }
 
 impl Processing {
@@ -134,6 +138,7 @@ impl Processing {
             last_merge: Instant::now(),
             processed_us: Stats::histogram(),
             latency: super::latency::StreamLatency::default(),
+            monitor: shared.monitor,
         };
         processing.pipeline.set_wanted(processing.fanout.wanted());
         processing
@@ -252,7 +257,9 @@ impl Processing {
         let received = frame.received;
         let natnet = frame.natnet.as_deref();
         let mut clients_changed = false;
+        let mut last = None;
         let mut emit = |e: &Emitted<'_>| {
+            last = Some(e.key);
             let processed = Instant::now();
             Stats::record(
                 processed_us,
@@ -271,6 +278,10 @@ impl Processing {
         }
         if clients_changed {
             self.pipeline.set_wanted(self.fanout.wanted());
+        }
+        // After the sends: the page's copy is never on the subscribers' path.
+        if let (Some(feed), Some(key)) = (self.monitor.as_mut(), last) {
+            feed.after_frame(&self.pipeline, &key);
         }
         if let Some(refusal) = self.pipeline.take_refusal() {
             self.tell_source(&refusal);
@@ -332,6 +343,11 @@ impl Processing {
         s.send = self.fanout.counters.clone();
         (s.poll_hits, s.poll_misses) = (self.poll_hits, self.poll_misses);
         s.clients = self.fanout.len() as u64;
+        s.recording = self.recording.as_ref().map(|r| {
+            let (path, raw) = r.paths();
+            let show = |p: &Path| p.display().to_string();
+            (show(path), raw.map(show))
+        });
         // Same bounds on both sides, so adding never fails.
         let _ = s.processed_us.add(&self.processed_us);
         self.processed_us.reset();

@@ -193,6 +193,11 @@ impl Recording {
         })
     }
 
+    /// The edited stream's first file, and the raw input's, as given.
+    pub fn paths(&self) -> (&Path, Option<&Path>) {
+        (&self.path, self.raw.as_deref())
+    }
+
     /// Whether this recording writes to `path` (its edited stream's first file).
     pub fn writes_to(&self, path: &Path) -> bool {
         absolute(path) == absolute(&self.path)

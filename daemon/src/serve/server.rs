@@ -26,6 +26,7 @@ use tokio_util::task::TaskTracker;
 use super::allow::AllowList;
 use super::command::Request;
 use super::control::{self, ControlCtx, Guard};
+use super::monitor::{Board, Feed};
 use super::processing::{Channels, InFrame, Processing, Shared};
 use super::sender::Fanout;
 use super::stats::Stats;
@@ -48,6 +49,8 @@ pub struct Bound {
     performers: Vec<Performer>,
     /// The NatNet source's sockets, when one is configured.
     natnet: Option<super::natnet::Link>,
+    /// The monitor page's listener, when the page is served.
+    monitor: Option<tokio::net::TcpListener>,
 }
 
 /// Binds both sockets and loads the models, so that a test learns the addresses before frames
@@ -90,7 +93,12 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
         .clone()
         .map(super::natnet::Link::open)
         .transpose()?;
+    let monitor = match config.monitor {
+        Some(addr) => Some(super::monitor::bind(addr).await?),
+        None => None,
+    };
     Ok(Bound {
+        monitor,
         frames,
         replies,
         control,
@@ -118,6 +126,14 @@ impl Bound {
         Ok(self.control.local_addr()?)
     }
 
+    /// The monitor page's address, when it is served.
+    ///
+    /// # Errors
+    /// The OS cannot tell.
+    pub fn monitor_addr(&self) -> Result<Option<SocketAddr>> {
+        Ok(self.monitor.as_ref().map(|l| l.local_addr()).transpose()?)
+    }
+
     /// Serves until `shutdown` is cancelled, then drains and returns.
     ///
     /// # Errors
@@ -136,6 +152,7 @@ impl Bound {
             queue_dropped: Arc::new(AtomicU64::new(0)),
             not_allowed: Arc::new(AtomicU64::new(0)),
             replies: None,
+            monitor: None,
         };
         let queue = Queue {
             tx: frame_tx,
@@ -163,11 +180,19 @@ impl Bound {
         };
         let every = self.config.stats_interval;
         let frames = self.frames;
+        let board = Arc::new(Board::new());
+        if let Some(listener) = self.monitor {
+            let token = self.config.monitor_token.clone();
+            let parts = (Arc::clone(&board), ctx.clone(), Arc::clone(&stats));
+            super::monitor::spawn(listener, token, parts, &tracker, shutdown.clone())?;
+        }
+        let feed = self.config.monitor.map(|_| Feed::new(board));
         let processing = processing_thread(
             (self.model, self.performers, self.config),
             channels,
             Shared {
                 replies: Some(self.replies),
+                monitor: feed,
                 ..shared
             },
         )?;

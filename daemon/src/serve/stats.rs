@@ -76,6 +76,23 @@ pub struct Stats {
     /// Per stream id: end-to-end latency from the source's capture time (NatNet: camera
     /// mid-exposure, through the echo's clock offset; OSC: a UTC capture time), µs.
     pub stream_latency_us: Vec<(i32, Histogram<u64>)>,
+    /// The recording running: the edited stream's file, and the raw input's.
+    pub recording: Option<(String, Option<String>)>,
+    /// The monitor page's counters (all 0 when it is off).
+    pub monitor: MonitorCounters,
+}
+
+/// The monitor page's counters, for `/status` and the page itself.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct MonitorCounters {
+    /// Pages connected now.
+    pub viewers: u64,
+    /// Feed messages a slow page did not take, dropped.
+    pub dropped: u64,
+    /// Snapshots the processing thread did not publish because the page's side held the board.
+    pub unpublished: u64,
+    /// Requests refused: no or a wrong token, a foreign Origin or Host, too many pages.
+    pub refused: u64,
 }
 
 impl Default for Stats {
@@ -108,6 +125,8 @@ impl Stats {
             dropped_not_allowed: 0,
             natnet: None,
             stream_latency_us: Vec::new(),
+            recording: None,
+            monitor: MonitorCounters::default(),
         }
     }
 
@@ -148,6 +167,10 @@ impl Stats {
             ("streams", self.streams),
             ("poll_hits", self.poll_hits),
             ("poll_misses", self.poll_misses),
+            ("monitor_viewers", self.monitor.viewers),
+            ("monitor_dropped", self.monitor.dropped),
+            ("monitor_unpublished", self.monitor.unpublished),
+            ("monitor_refused", self.monitor.refused),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), int(v)))
@@ -156,6 +179,8 @@ impl Stats {
             out.push((format!("bad_{}", kind.as_str()), int(c.bad[kind.index()])));
         }
         out.push(("model".into(), StatusValue::Text(self.model.clone())));
+        let recording = self.recording.as_ref().map_or("", |r| r.0.as_str());
+        out.push(("recording".into(), StatusValue::Text(recording.into())));
         for st in &self.per_stream {
             stream_pairs(st, &mut out);
         }

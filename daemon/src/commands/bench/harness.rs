@@ -61,19 +61,27 @@ impl Run {
     }
 }
 
-/// Paced traffic through the daemon.
+/// How long a round with the monitor waits for a page to open.
+const PAGE_WAIT: Duration = Duration::from_secs(60);
+
+/// Paced traffic through the daemon; with `monitor`, the daemon serves the monitor page there
+/// and the traffic starts once a page is open.
 pub(super) async fn through_daemon(
     model: &IcaModel,
-    performers: usize,
-    clients: usize,
+    (performers, clients): (usize, usize),
     rate_hz: f64,
     secs: Duration,
     poll_window_us: u64,
+    monitor: Option<&str>,
 ) -> Result<Run> {
     let (receivers, addrs) = receivers(clients).await?;
-    let raw = daemon_config(&addrs, poll_window_us);
+    let mut raw = daemon_config(&addrs, poll_window_us);
+    raw.monitor = monitor.map(String::from);
     let daemon = Daemon::start_with(raw.validate()?, model.clone()).await?;
     let traffic = async {
+        if monitor.is_some() {
+            page_open(daemon.control).await?;
+        }
         let sent = send_all(model, performers, daemon.frames, rate_hz, secs).await?;
         tokio::time::sleep(Duration::from_millis(200)).await;
         let status = ControlClient::new(daemon.control).await?.status().await?;
@@ -137,6 +145,25 @@ pub(super) async fn through_relay(
         .context("joining the relay")?
         .map_err(|_| anyhow::anyhow!("the relay panicked"))?;
     Ok(collect(receivers).await)
+}
+
+/// Waits until a monitor page is open on the daemon at `control` (its WebSocket connected; a
+/// page reconnects by itself when a round starts a new daemon).
+async fn page_open(control: SocketAddr) -> Result<()> {
+    let client = ControlClient::new(control).await?;
+    let start = Instant::now();
+    while start.elapsed() < PAGE_WAIT {
+        let status = client.status().await?;
+        if crate::loopback::counter(&status, "monitor_viewers").unwrap_or(0) > 0 {
+            // A moment for the page to take its first snapshots and models.
+            tokio::time::sleep(Duration::from_millis(500)).await;
+            return Ok(());
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    anyhow::bail!(
+        "no monitor page opened within {PAGE_WAIT:?}: open the URL printed above in a browser"
+    )
 }
 
 pub(super) type Receivers = Vec<Collecting<Seen>>;

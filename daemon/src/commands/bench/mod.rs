@@ -8,6 +8,10 @@
 //!    where frames went (from `/status`).
 //! 3. One processing thread: frames through [`Pipeline`] back to back (109 markers, m = 20).
 //!
+//! With `--monitor IP:PORT`, every round also runs the daemon with the monitor page served
+//! there, once a browser shows it (the page reconnects to each round's daemon), and prints its
+//! latencies against the rounds without it.
+//!
 //! With `--natnet`, NatNet sources join the paced rounds: the same performers as markersets
 //! of a Motive stand-in's NatNet stream ([`natnet`]), multicast (Motive's default; the kernel's
 //! multicast loopback is part of the path) and unicast, each compared with the OSC source
@@ -54,10 +58,12 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
     let rounds = (args.seconds / ROUND.as_secs_f64()).ceil().max(1.0) as u32;
     let per_round = Duration::from_secs_f64(args.seconds) / rounds;
     let (n, k) = (args.performers, args.clients);
-    let (daemon, relay, max, over_natnet) = runtime.block_on(async {
+    let monitor = args.monitor.as_deref();
+    let (daemon, watched, relay, max, over_natnet) = runtime.block_on(async {
         let w = args.poll_window_us;
-        let mut daemon = through_daemon(&model, n, k, 120.0, per_round, w).await?;
+        let mut daemon = through_daemon(&model, (n, k), 120.0, per_round, w, None).await?;
         let mut relay = through_relay(&model, n, k, per_round).await?;
+        let mut watched: Option<Run> = None;
         let mut over_natnet: [Option<Run>; 2] = [None, None];
         for round in 0..rounds {
             for (multicast, all) in [true, false].into_iter().zip(over_natnet.iter_mut()) {
@@ -71,13 +77,21 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
                     Some(all) => Run::add(all, r),
                 }
             }
+            if monitor.is_some() {
+                let run = through_daemon(&model, (n, k), 120.0, per_round, w, monitor).await?;
+                match watched.as_mut() {
+                    None => watched = Some(run),
+                    Some(all) => all.add(run),
+                }
+            }
             if round + 1 < rounds {
-                daemon.add(through_daemon(&model, n, k, 120.0, per_round, w).await?);
+                daemon.add(through_daemon(&model, (n, k), 120.0, per_round, w, None).await?);
                 relay.add(&through_relay(&model, n, k, per_round).await?);
             }
         }
-        let max = through_daemon(&model, 1, 1, MAX_RATE_HZ, Duration::from_secs(1), w).await?;
-        anyhow::Ok((daemon, relay, max, over_natnet))
+        let one = Duration::from_secs(1);
+        let max = through_daemon(&model, (1, 1), MAX_RATE_HZ, one, w, None).await?;
+        anyhow::Ok((daemon, watched, relay, max, over_natnet))
     })?;
     let sent = daemon.sent * k as u64;
     crate::out!(
@@ -115,6 +129,9 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
             print_natnet(nn, how, (&daemon, &relay), k)?;
         }
     }
+    if let Some(watched) = &watched {
+        print_watched(&daemon, watched, k)?;
+    }
     print_max_rate(&max)?;
     let (per_frame_us, fps) = processing_rate(&model)?;
     crate::out!(
@@ -147,6 +164,27 @@ fn print_natnet(
              {r} µs, ratio {:.2}x)",
             n as f64 / o.max(1) as f64,
             n as f64 / r.max(1) as f64
+        );
+    }
+    Ok(())
+}
+
+/// The rounds with the monitor page open against the rounds without, same run.
+fn print_watched(daemon: &Run, watched: &Run, clients: usize) -> Result<()> {
+    crate::out!(
+        "with the monitor page open: {} of ~{} datagrams received; page feed dropped {}, \
+         snapshots unpublished {}",
+        watched.seen.received,
+        watched.sent * clients as u64,
+        watched.get("monitor_dropped"),
+        watched.get("monitor_unpublished"),
+    );
+    for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999)] {
+        let with = watched.seen.latency_us.value_at_quantile(q);
+        let without = daemon.seen.latency_us.value_at_quantile(q);
+        crate::out!(
+            "{label} added latency with the page open: {with} µs (without {without} µs, ratio {:.2}x)",
+            with as f64 / without.max(1) as f64
         );
     }
     Ok(())

@@ -8,8 +8,12 @@
 //! 5. a client subscribed with the compact profile receives the edited stream;
 //! 6. a summary: frames, loss, latency percentiles, the emotion state seen, the components and
 //!    their roles, and the path of the HTML report.
+//!
+//! With `--monitor [IP:PORT]`, steps 4 to 6 become: the daemon with the monitor page served,
+//! the take looping until Ctrl-C (`monitor`).
 
 mod live;
+mod monitor;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -125,6 +129,13 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
     let regions = session.regions.as_deref();
     let model = analyze_and_write(&model_path, &session.manifest, regions, &report)?;
     let take = Arc::new(crate::offline::load_take(&session.take)?);
+    if let Some(addr) = &args.monitor {
+        step(
+            4,
+            "serving on loopback with the monitor page, the take looping",
+        )?;
+        return monitor::serve(&model, take, addr);
+    }
     step(4, "serving on loopback and replaying a take through it")?;
     let live = live::stream(&model, take, &session.sweep)?;
     step(5, "summary")?;

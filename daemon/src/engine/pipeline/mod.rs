@@ -194,6 +194,11 @@ impl Pipeline {
         self.streams.len()
     }
 
+    /// The stream of `key`, to read between datagrams (the monitor tap).
+    pub fn stream(&self, key: &StreamKey) -> Option<&crate::engine::Stream> {
+        self.streams.get(key)
+    }
+
     /// Each stream's counters.
     pub fn stream_status(&self) -> Vec<StreamStatus> {
         self.streams.status(&self.performers)

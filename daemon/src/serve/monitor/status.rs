@@ -1,0 +1,180 @@
+//! The page's health view: the daemon's counters ([`Stats`], what `/status` answers) as one
+//! JSON text, with latency percentiles over the last few seconds as well as since the start
+//! (a jump shows at once, not diluted by an hour of good frames).
+
+use std::collections::VecDeque;
+
+use hdrhistogram::Histogram;
+use serde_json::{json, Value};
+
+use crate::engine::StreamStatus;
+use crate::serve::stats::{MonitorCounters, Stats, SubscriberStatus};
+
+/// Seconds the recent latency window spans.
+pub(crate) const WINDOW_S: usize = 5;
+
+/// The latency histograms since the start, kept once a second for the recent window.
+#[derive(Debug, Default)]
+pub(crate) struct Latency {
+    /// (processed, sent) since the start, oldest first, one a second.
+    ring: VecDeque<(Histogram<u64>, Histogram<u64>)>,
+    /// The percentiles last computed.
+    last: Value,
+}
+
+impl Latency {
+    /// Keeps this second's histograms (copied out under the stats lock by the caller) and
+    /// computes the percentiles.
+    pub(crate) fn observe(&mut self, processed: Histogram<u64>, sent: Histogram<u64>) {
+        if self.ring.len() > WINDOW_S {
+            self.ring.pop_front();
+        }
+        self.ring.push_back((processed, sent));
+        let (Some(first), Some(now)) = (self.ring.front(), self.ring.back()) else {
+            return;
+        };
+        let stage = |old: &Histogram<u64>, now: &Histogram<u64>| {
+            let mut recent = now.clone();
+            // Counts only grow, so the older copy subtracts; if not, show the whole.
+            if recent.subtract(old).is_err() {
+                recent = now.clone();
+            }
+            let q = |h: &Histogram<u64>, q: f64| h.value_at_quantile(q);
+            json!({
+                "p50": q(&recent, 0.5), "p99": q(&recent, 0.99), "max": recent.max(),
+                "n": recent.len(),
+                "p50_all": q(now, 0.5), "p99_all": q(now, 0.99), "max_all": now.max(),
+            })
+        };
+        self.last = json!({
+            "window_s": self.ring.len().saturating_sub(1),
+            "processed": stage(&first.0, &now.0),
+            "sent": stage(&first.1, &now.1),
+        });
+    }
+
+    /// The percentiles last computed.
+    pub(crate) fn value(&self) -> &Value {
+        &self.last
+    }
+}
+
+/// What the health view shows, copied out of the stats under its lock.
+#[derive(Debug)]
+pub(crate) struct Health {
+    value: Value,
+}
+
+impl Health {
+    /// Copies the counters out (quick: no percentile is computed under the lock).
+    pub(crate) fn of(s: &Stats) -> Health {
+        let c = &s.counters;
+        let value = json!({
+            "model": s.model,
+            "frames_in": c.frames_in,
+            "frames_out": c.frames_out,
+            "drops": {
+                "queue_full": c.dropped_queue_full,
+                "duplicate": c.dropped_duplicate,
+                "stale": c.dropped_stale,
+                "no_layout": c.dropped_no_layout,
+                "unmatched": c.dropped_unmatched,
+                "not_allowed": s.dropped_not_allowed,
+                "bad_packets": c.bad_total(),
+                "send_buffer": s.send.dropped_send_buffer,
+                "send_errors": s.send.send_errors,
+                "frame_errors": c.frame_errors,
+            },
+            "missing_markers": c.missing_markers,
+            "glitches": c.glitches,
+            "restarts": c.restarts,
+            "labels_refused": c.labels_refused,
+            "control_refused": s.control_refused,
+            "streams": s.per_stream.iter().map(stream).collect::<Vec<_>>(),
+            "subscribers": s.subscribers.iter().map(subscriber).collect::<Vec<_>>(),
+            "recording": s.recording.as_ref().map(|(p, raw)| json!({"path": p, "raw": raw})),
+        });
+        Health { value }
+    }
+
+    /// The `status` message, with the latencies and the monitor's own counters.
+    pub(crate) fn into_message(mut self, latency: &Latency, monitor: MonitorCounters) -> String {
+        self.value["type"] = json!("status");
+        self.value["latency"] = latency.value().clone();
+        self.value["monitor"] = json!({
+            "viewers": monitor.viewers,
+            "dropped": monitor.dropped,
+            "unpublished": monitor.unpublished,
+            "refused": monitor.refused,
+        });
+        self.value.to_string()
+    }
+}
+
+fn stream(st: &StreamStatus) -> Value {
+    json!({
+        "id": st.id,
+        "name": st.name,
+        "source": format!("{}/{}", st.key.source, st.key.layout_id),
+        "performer": st.performer,
+        "model_markers": st.model_markers,
+        "matched_markers": st.model_markers - st.unmatched_markers.min(st.model_markers),
+        "target": st.target,
+        "amount": st.amount,
+        "frames": st.frames,
+        "duplicates": st.duplicates,
+        "stale": st.stale,
+    })
+}
+
+fn subscriber(sub: &SubscriberStatus) -> Value {
+    json!({
+        "address": sub.addr.to_string(),
+        "profile": sub.profile.as_str(),
+        "performer": sub.performer,
+        "lease_ms": sub.lease_ms,
+        "sends": sub.sends,
+        "failures": sub.failures,
+        "backing_off": sub.backing_off,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_recent_window_shows_a_jump_the_whole_run_hides() {
+        let mut lat = Latency::default();
+        let (mut p, s) = (Stats::histogram(), Stats::histogram());
+        for _ in 0..100_000 {
+            Stats::record(&mut p, 100);
+        }
+        for _ in 0..=WINDOW_S {
+            lat.observe(p.clone(), s.clone());
+        }
+        for _ in 0..1_000 {
+            Stats::record(&mut p, 5_000);
+        }
+        lat.observe(p.clone(), s.clone());
+        let v = lat.value();
+        assert_eq!(
+            v["processed"]["p50"], 5_003,
+            "the last seconds: all slow (5 ms, to 3 digits)"
+        );
+        assert_eq!(v["processed"]["p99_all"], 100, "since the start: 1 % slow");
+        assert_eq!(v["window_s"], WINDOW_S);
+    }
+
+    #[test]
+    fn health_counts_drops_by_reason_and_lists_the_recording() {
+        let mut s = Stats::new();
+        s.counters.dropped_stale = 4;
+        s.recording = Some(("take.c3d".into(), None));
+        let msg = Health::of(&s).into_message(&Latency::default(), MonitorCounters::default());
+        let v: Value = serde_json::from_str(&msg).expect("json");
+        assert_eq!(v["drops"]["stale"], 4);
+        assert_eq!(v["recording"]["path"], "take.c3d");
+        assert_eq!(v["type"], "status");
+    }
+}
