@@ -12,6 +12,7 @@
 //!   and [`Whitener::whiten_into`] whitens one chunk at a time into a caller buffer.
 
 mod eigen;
+mod kernels;
 mod moments;
 mod pca;
 mod stats;

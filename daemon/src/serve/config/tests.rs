@@ -14,7 +14,7 @@ fn defaults_bind_loopback_and_unknown_keys_are_named() {
 
 #[test]
 fn the_example_config_parses_and_holds_the_defaults() {
-    let text = include_str!("../../../docs/emoshift.toml");
+    let text = include_str!("../../../../docs/emoshift.toml");
     let c = RawConfig::from_toml(text)
         .expect("the example parses")
         .validate()

@@ -3,6 +3,8 @@
 //! recording; counters merged into the shared [`Stats`] between bursts. While its queue is
 //! empty it parks, or polls around a steady source's next expected frame ([`ArrivalClock`]).
 
+mod requests;
+
 use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::path::Path;
@@ -13,9 +15,9 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender};
 
 use super::arrival::{ArrivalClock, SpinWindow, Wait};
-use super::command::{Command, Refusal, Reply, Request};
+use super::command::Request;
 use super::monitor::Feed;
-use super::record::{close_in_background, finish_recording, RecordError, Recording};
+use super::record::{finish_recording, Recording};
 use super::sender::Fanout;
 use super::stats::{Stats, SubscriberStatus};
 use crate::engine::pipeline::{Emitted, Pipeline, Refusal as Refused};
@@ -354,63 +356,5 @@ impl Processing {
         let _ = s.sent_us.add(&self.fanout.sent_us);
         self.fanout.sent_us.reset();
         self.latency.merge_into(&mut s.stream_latency_us);
-    }
-
-    fn command(&mut self, request: Request) {
-        let Request { command, reply } = request;
-        let answer: Option<Reply> = match command {
-            Command::Edit(control) => Some(
-                self.pipeline
-                    .handle_edit(&control)
-                    .map_err(|e| Refusal::Edit(e.to_string())),
-            ),
-            Command::Client { peer, control } => {
-                let r = self.fanout.command(peer, &control);
-                self.pipeline.set_wanted(self.fanout.wanted());
-                Some(r.map_err(Refusal::Client))
-            }
-            Command::SetModel(model) => Some(
-                self.pipeline
-                    .check_model(&model)
-                    .map(|()| self.pipeline.set_model(model))
-                    .map_err(|e| Refusal::Model(e.to_string())),
-            ),
-            Command::RecordStart {
-                path,
-                raw,
-                overwrite,
-            } => Some(self.record_start(&path, raw.as_deref(), overwrite)),
-            Command::RecordStop => match self.recording.take() {
-                Some(rec) => {
-                    // Answered by the closing thread once the files are complete.
-                    self.closing.push(close_in_background(rec, Some(reply)));
-                    return;
-                }
-                None => Some(Err(Refusal::Record("no recording in progress".into()))),
-            },
-        };
-        if let Some(answer) = answer {
-            let _ = reply.send(answer);
-        }
-    }
-}
-
-impl Processing {
-    /// Starts a recording: refused while one runs to the same path; one running to another
-    /// path is closed once the new one is ready (a bad new path leaves it running).
-    fn record_start(&mut self, path: &Path, raw: Option<&Path>, overwrite: bool) -> Reply {
-        let refused = |e: RecordError| Refusal::from_error(Refusal::Record, &e);
-        if let Some(running) = &self.recording {
-            if running.writes_to(path) {
-                let path = path.display().to_string();
-                return Err(refused(RecordError::Running { path }));
-            }
-        }
-        let rec = Recording::start(path, raw, overwrite).map_err(refused)?;
-        if let Some(old) = self.recording.replace(rec) {
-            tracing::info!(target: "emoshift", to = %path.display(), "recording closed for a new one");
-            self.closing.push(close_in_background(old, None));
-        }
-        Ok(())
     }
 }
