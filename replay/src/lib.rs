@@ -7,6 +7,7 @@
 //! This crate must not know about ICA models (the daemon joins takes and models).
 #![warn(missing_docs)]
 
+pub mod blocks;
 pub mod c3d;
 pub mod csv;
 pub mod error;
