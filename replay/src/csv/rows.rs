@@ -7,6 +7,7 @@ use super::header::{parse_comment, parse_header, Meta};
 use super::rate;
 use crate::blocks::TakeHeader;
 use crate::error::ReadError;
+use crate::trc::row_blocks::{NextRow, RowBlocks};
 use crate::trc::text::{self, check_frame_number, parse_time, Lines};
 use crate::{Take, Units};
 
@@ -15,19 +16,22 @@ use crate::{Take, Units};
 /// whole-file reader does (16 bytes a frame).
 #[derive(Debug)]
 pub struct CsvBlocks<R> {
-    lines: Lines<R>,
     header: TakeHeader,
+    rows: RowBlocks<CsvRows<R>>,
+}
+
+/// The CSV row parser of [`RowBlocks`].
+#[derive(Debug)]
+struct CsvRows<R> {
+    lines: Lines<R>,
+    labels: Vec<String>,
+    scale: f64,
     /// Columns between `time` and the markers.
     extra: usize,
-    /// One parsed row, reused; holds the first row until the first block.
-    xyz: Vec<f32>,
-    gone: Vec<bool>,
-    pending: bool,
     next_frame: Option<i64>,
-    rows: usize,
     done: bool,
     /// `(line, time_s)` per row, kept only when the rate must be derived.
-    times: Vec<(usize, f64)>,
+    times: Option<Vec<(usize, f64)>>,
     max_decimals: Option<u32>,
 }
 
@@ -52,31 +56,26 @@ impl<R: BufRead> CsvBlocks<R> {
                 }
             }
         };
-        let n = labels.len();
-        let mut blocks = CsvBlocks {
+        let units = meta.units.unwrap_or(Units::Millimetres);
+        let parser = CsvRows {
             lines,
-            header: TakeHeader {
-                labels,
-                rate_hz: meta.rate_hz,
-                first_frame: 1,
-                frames: None,
-                source_units: meta.units.unwrap_or(Units::Millimetres),
-            },
+            labels: labels.clone(),
+            scale: f64::from(units.to_mm()),
             extra,
-            xyz: vec![0.0; n * 3],
-            gone: vec![false; n],
-            pending: false,
             next_frame: None,
-            rows: 0,
             done: false,
-            times: Vec::new(),
+            times: meta.rate_hz.is_none().then(Vec::new),
             max_decimals: Some(0),
         };
-        if let Some(frame) = blocks.next_row()? {
-            blocks.header.first_frame = frame;
-            blocks.pending = true;
-        }
-        Ok(blocks)
+        let rows = RowBlocks::start(parser, labels.len(), 1)?;
+        let header = TakeHeader {
+            labels,
+            rate_hz: meta.rate_hz,
+            first_frame: rows.first_frame(),
+            frames: None,
+            source_units: units,
+        };
+        Ok(CsvBlocks { header, rows })
     }
 
     /// The take's header.
@@ -89,17 +88,34 @@ impl<R: BufRead> CsvBlocks<R> {
     /// # Errors
     /// [`ReadError::NoRate`] or [`ReadError::UnevenTime`] when it cannot be derived.
     pub fn rate_hz(&self) -> Result<f64, ReadError> {
-        if let Some(rate) = self.header.rate_hz {
-            return Ok(rate);
+        let parser = &self.rows.parser;
+        match (self.header.rate_hz, &parser.times) {
+            (Some(rate), _) => Ok(rate),
+            (None, times) => {
+                let resolution_s = parser
+                    .max_decimals
+                    .map_or(0.0, |d| 10f64.powi(-(d.min(300) as i32)));
+                rate::derive_rate(times.as_deref().unwrap_or(&[]), resolution_s)
+            }
         }
-        let resolution_s = self
-            .max_decimals
-            .map_or(0.0, |d| 10f64.powi(-(d.min(300) as i32)));
-        rate::derive_rate(&self.times, resolution_s)
     }
 
-    /// Parses the next data row into the row buffers; `None` at the end of the file.
-    fn next_row(&mut self) -> Result<Option<i64>, ReadError> {
+    /// See [`crate::blocks::BlockReader::read_block`].
+    ///
+    /// # Errors
+    /// As [`super::read`], for the rows read.
+    pub fn read_block(&mut self, max_frames: usize, block: &mut Take) -> Result<usize, ReadError> {
+        self.rows.read_block(max_frames, block)
+    }
+}
+
+impl<R: BufRead> NextRow for CsvRows<R> {
+    fn next_row(
+        &mut self,
+        _rows: usize,
+        xyz: &mut [f32],
+        gone: &mut [bool],
+    ) -> Result<Option<i64>, ReadError> {
         if self.done {
             return Ok(None);
         }
@@ -107,7 +123,7 @@ impl<R: BufRead> CsvBlocks<R> {
             self.done = true;
             return Ok(None);
         };
-        let width = 2 + self.extra + self.xyz.len();
+        let width = 2 + self.extra + xyz.len();
         let cells: Vec<&str> = row.split(',').collect();
         if cells.len() != width {
             let found = cells.len();
@@ -121,39 +137,16 @@ impl<R: BufRead> CsvBlocks<R> {
         self.next_frame = Some(frame.wrapping_add(1));
         let time_s = parse_time(cells[1])
             .ok_or_else(|| text::bad_cell(line, 1, "time", "a time in seconds", cells[1]))?;
-        if self.header.rate_hz.is_none() {
-            self.times.push((line, time_s));
+        if let Some(times) = self.times.as_mut() {
+            times.push((line, time_s));
             self.max_decimals = self
                 .max_decimals
                 .zip(rate::decimals(cells[1]))
                 .map(|(a, b)| a.max(b));
         }
         let first = 2 + self.extra;
-        let scale = f64::from(self.header.source_units.to_mm());
-        let labels = &self.header.labels;
-        let (xyz, gone) = (&mut self.xyz, &mut self.gone);
+        let (labels, scale) = (&self.labels, self.scale);
         text::parse_samples(line, &cells[first..], first, labels, scale, xyz, gone)?;
-        self.rows += 1;
         Ok(Some(frame))
-    }
-
-    /// See [`crate::blocks::BlockReader::read_block`].
-    ///
-    /// # Errors
-    /// As [`super::read`], for the rows read.
-    pub fn read_block(&mut self, max_frames: usize, block: &mut Take) -> Result<usize, ReadError> {
-        block.positions.clear();
-        block.missing.clear();
-        let before = self.rows - usize::from(self.pending);
-        block.first_frame = self.header.first_frame.wrapping_add(before as i64);
-        let mut count = 0;
-        while count < max_frames {
-            if !std::mem::take(&mut self.pending) && self.next_row()?.is_none() {
-                break;
-            }
-            block.push_frame(&self.xyz, &self.gone);
-            count += 1;
-        }
-        Ok(count)
     }
 }

@@ -35,6 +35,7 @@
 //! (round trips are exact), times to the microsecond, and empty cells for missing samples.
 
 mod header;
+pub(crate) mod row_blocks;
 mod rows;
 pub(crate) mod text;
 

@@ -4,31 +4,29 @@
 use std::io::BufRead;
 
 use super::header::read_header;
+use super::row_blocks::{NextRow, RowBlocks};
 use super::text::{self, check_frame_number, parse_time, Lines};
 use crate::blocks::TakeHeader;
 use crate::error::ReadError;
 use crate::Take;
 
-/// Frames to reserve room for up front at most, so a lying `NumFrames` cannot make us allocate
-/// gigabytes before reading a single row.
-const MAX_RESERVED_FRAMES: usize = 10_000;
-
 /// A TRC file read row block by row block; see [`crate::blocks`].
 #[derive(Debug)]
 pub struct TrcBlocks<R> {
-    lines: Lines<R>,
     header: TakeHeader,
+    rows: RowBlocks<TrcRows<R>>,
+}
+
+/// The TRC row parser of [`RowBlocks`].
+#[derive(Debug)]
+struct TrcRows<R> {
+    lines: Lines<R>,
     row: RowParser,
-    /// One parsed row, reused; holds the first row between [`TrcBlocks::new`] and the first
-    /// block (it names the first frame).
-    xyz: Vec<f32>,
-    gone: Vec<bool>,
-    pending: bool,
     /// The current row's text.
     text: String,
     next_frame: Option<i64>,
-    /// Rows read so far.
-    rows: usize,
+    /// `NumFrames`.
+    declared: usize,
     done: bool,
 }
 
@@ -40,33 +38,26 @@ impl<R: BufRead> TrcBlocks<R> {
     pub fn new(input: R) -> Result<Self, ReadError> {
         let mut lines = Lines::new(input);
         let h = read_header(&mut lines)?;
-        let n = h.labels.len();
-        let mut blocks = TrcBlocks {
+        let parser = TrcRows {
             lines,
             row: RowParser {
                 labels: h.labels.clone(),
                 scale: f64::from(h.units.to_mm()),
             },
-            header: TakeHeader {
-                labels: h.labels,
-                rate_hz: Some(h.rate_hz),
-                first_frame: h.start_frame.unwrap_or(1),
-                frames: Some(h.num_frames),
-                source_units: h.units,
-            },
-            xyz: vec![0.0; n * 3],
-            gone: vec![false; n],
-            pending: false,
             text: String::new(),
             next_frame: None,
-            rows: 0,
+            declared: h.num_frames,
             done: false,
         };
-        if let Some(frame) = blocks.next_row()? {
-            blocks.header.first_frame = frame;
-            blocks.pending = true;
-        }
-        Ok(blocks)
+        let rows = RowBlocks::start(parser, h.labels.len(), h.start_frame.unwrap_or(1))?;
+        let header = TakeHeader {
+            labels: h.labels,
+            rate_hz: Some(h.rate_hz),
+            first_frame: rows.first_frame(),
+            frames: Some(h.num_frames),
+            source_units: h.units,
+        };
+        Ok(TrcBlocks { header, rows })
     }
 
     /// The take's header.
@@ -74,18 +65,31 @@ impl<R: BufRead> TrcBlocks<R> {
         &self.header
     }
 
-    /// Parses the next data row into the row buffers; `None` at the end of the file, after
-    /// checking the row count against `NumFrames`.
-    fn next_row(&mut self) -> Result<Option<i64>, ReadError> {
+    /// See [`crate::blocks::BlockReader::read_block`].
+    ///
+    /// # Errors
+    /// As [`super::read`], for the rows read; [`ReadError::FrameCountMismatch`] at the end.
+    pub fn read_block(&mut self, max_frames: usize, block: &mut Take) -> Result<usize, ReadError> {
+        self.rows.read_block(max_frames, block)
+    }
+}
+
+impl<R: BufRead> NextRow for TrcRows<R> {
+    /// At the end of the file, checks the row count against `NumFrames`.
+    fn next_row(
+        &mut self,
+        rows: usize,
+        xyz: &mut [f32],
+        gone: &mut [bool],
+    ) -> Result<Option<i64>, ReadError> {
         if self.done {
             return Ok(None);
         }
         // The row is copied out because `lines` stays borrowed while its text is.
         let Some((line, text)) = self.lines.next_non_blank()? else {
             self.done = true;
-            let declared = self.header.frames.unwrap_or(0);
-            if self.rows != declared {
-                let found = self.rows;
+            if rows != self.declared {
+                let (declared, found) = (self.declared, rows);
                 return Err(ReadError::FrameCountMismatch { declared, found });
             }
             return Ok(None);
@@ -95,37 +99,11 @@ impl<R: BufRead> TrcBlocks<R> {
         // A short row is read as trailing missing markers, unless it is an unterminated last
         // line: then the file was cut off and those markers were lost, not missing.
         let complete = self.lines.terminated();
-        let (xyz, gone) = (&mut self.xyz, &mut self.gone);
         let frame = self
             .row
             .parse(line, &self.text, complete, self.next_frame, xyz, gone)?;
         self.next_frame = Some(frame.wrapping_add(1));
-        self.rows += 1;
         Ok(Some(frame))
-    }
-
-    /// See [`crate::blocks::BlockReader::read_block`].
-    ///
-    /// # Errors
-    /// As [`super::read`], for the rows read; [`ReadError::FrameCountMismatch`] at the end.
-    pub fn read_block(&mut self, max_frames: usize, block: &mut Take) -> Result<usize, ReadError> {
-        block.positions.clear();
-        block.missing.clear();
-        let n = self.xyz.len() / 3;
-        let reserve = max_frames.min(MAX_RESERVED_FRAMES) * n;
-        block.positions.reserve(reserve * 3);
-        block.missing.reserve(reserve);
-        let before = self.rows - usize::from(self.pending);
-        block.first_frame = self.header.first_frame.wrapping_add(before as i64);
-        let mut count = 0;
-        while count < max_frames {
-            if !std::mem::take(&mut self.pending) && self.next_row()?.is_none() {
-                break;
-            }
-            block.push_frame(&self.xyz, &self.gone);
-            count += 1;
-        }
-        Ok(count)
     }
 }
 
