@@ -202,7 +202,8 @@ pub struct EditArgs {
     /// takes are held whole in memory).
     #[arg(long, value_name = "OTHER")]
     pub replace_emotion_from: Option<PathBuf>,
-    /// Copy & Add: add the emotion series of another take under --other-model.
+    /// Copy & Add: add the emotion series of another take under --other-model (both takes are
+    /// held whole in memory).
     #[arg(long, value_name = "OTHER", requires = "other_model")]
     pub add_emotion_from: Option<PathBuf>,
     /// The second model of Copy & Add.
