@@ -203,3 +203,31 @@ fn a_writer_refuses_another_count_than_it_declared() {
         );
     }
 }
+
+#[test]
+fn damaged_c3d_is_an_error_in_blocks_never_a_panic() {
+    let bytes = bytes_of(Format::C3d, &synthetic(4, 20, 1));
+    let read_all = |data: &[u8], len: Option<u64>| -> Result<usize, ReadError> {
+        let mut reader = BlockReader::new(Format::C3d, data, len)?;
+        let mut block = reader.header().empty_take();
+        let mut frames = 0;
+        while let n @ 1.. = reader.read_block(3, &mut block)? {
+            frames += n;
+        }
+        Ok(frames)
+    };
+    assert_eq!(read_all(&bytes, None).expect("intact"), 20);
+    // The last block is padding after the data: any cut before it loses frames.
+    for cut in (0..bytes.len() - 512).step_by(37) {
+        assert!(read_all(&bytes[..cut], None).is_err(), "cut at {cut}");
+    }
+    // Every header and parameter byte set to a few bad values: an error or a take, no panic.
+    let end = 2 * 512 + 512;
+    for at in 0..end.min(bytes.len()) {
+        for value in [0u8, 1, 0x7f, 0xff] {
+            let mut damaged = bytes.clone();
+            damaged[at] = value;
+            let _ = read_all(&damaged, Some(damaged.len() as u64));
+        }
+    }
+}

@@ -31,6 +31,10 @@ pub fn edit_file(
     if request.replace_from.is_some() || request.add_from.is_some() {
         bail!("Copy & Replace and Copy & Add align whole takes: use edit_take");
     }
+    // Named here: the file written first is the hidden one (see the module docs).
+    if replay::Format::from_path(out).is_none() {
+        return Err(replay::WriteError::UnknownFormat(out.into()).into());
+    }
     let mut plan = plan(request, model_path, model)?;
     let mut source = Source::open(path, max_bytes)?;
     let map = label_map(model, &source)?;
