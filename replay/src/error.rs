@@ -200,4 +200,12 @@ pub enum WriteError {
     /// The take breaks an invariant.
     #[error(transparent)]
     Invalid(#[from] TakeError),
+    /// A take written in blocks ended with another frame count than its header declared.
+    #[error("header declares {declared} frames but {written} were written")]
+    FrameCountMismatch {
+        /// Frames the header declares.
+        declared: usize,
+        /// Frames written.
+        written: usize,
+    },
 }

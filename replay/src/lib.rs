@@ -2,11 +2,14 @@
 //!
 //! Main types: [`Take`] (labels, rate, first frame, positions in mm, missing mask), [`Format`],
 //! [`load`] and [`save`]; [`pacer::Pacer`], the sans-IO schedule `emoshift replay` sends a take
-//! on; [`record::Recorder`], which writes a take frame by frame as it arrives.
+//! on; [`record::Recorder`], which writes a take frame by frame as it arrives;
+//! [`blocks::BlockReader`] and [`blocks::TakeWriter`], which read and write a take in blocks of
+//! frames so a long take never has to be held whole.
 //!
 //! This crate must not know about ICA models (the daemon joins takes and models).
 #![warn(missing_docs)]
 
+pub mod blocks;
 pub mod c3d;
 pub mod csv;
 pub mod error;

@@ -157,12 +157,16 @@ pub struct ProjectArgs {
     pub model: PathBuf,
     /// The take to project.
     pub file: PathBuf,
-    /// Output CSV: `frame,time,c0,...,c{m-1}`.
+    /// Output CSV: `frame,time,c0,...,c{m-1}`. Written as the take is read, in blocks of
+    /// frames, so memory does not grow with the take.
     #[arg(long)]
     pub out: PathBuf,
     /// Overwrite the output if it exists.
     #[arg(long)]
     pub force: bool,
+    /// Frames read and projected at a time (tests and measurements).
+    #[arg(long, hide = true, default_value_t = crate::offline::streamed::BLOCK_FRAMES)]
+    pub block_frames: usize,
 }
 
 /// `emoshift edit`.
@@ -173,7 +177,9 @@ pub struct EditArgs {
     pub model: PathBuf,
     /// The take to edit.
     pub file: PathBuf,
-    /// Output take; its extension picks the format.
+    /// Output take; its extension picks the format. Raw and emotion edits stream the take
+    /// from file to output in blocks of frames (memory does not grow with the take; a mean-based
+    /// --to-emotion reads the file twice); Copy & Replace and Copy & Add hold both takes whole.
     #[arg(long)]
     pub out: PathBuf,
     /// Translate component k by alpha: `--translate 2=0.5` (repeatable).
@@ -192,10 +198,12 @@ pub struct EditArgs {
     /// component over this many seconds, instead of the take's mean (same output as `serve`).
     #[arg(long, value_name = "SECONDS", requires = "to_emotion")]
     pub lowpass: Option<f64>,
-    /// Copy & Replace: take the emotion series of another take (DTW-aligned to this one).
+    /// Copy & Replace: take the emotion series of another take (DTW-aligned to this one; both
+    /// takes are held whole in memory).
     #[arg(long, value_name = "OTHER")]
     pub replace_emotion_from: Option<PathBuf>,
-    /// Copy & Add: add the emotion series of another take under --other-model.
+    /// Copy & Add: add the emotion series of another take under --other-model (both takes are
+    /// held whole in memory).
     #[arg(long, value_name = "OTHER", requires = "other_model")]
     pub add_emotion_from: Option<PathBuf>,
     /// The second model of Copy & Add.
@@ -207,6 +215,9 @@ pub struct EditArgs {
     /// Overwrite the output if it exists.
     #[arg(long)]
     pub force: bool,
+    /// Frames read and edited at a time (tests and measurements).
+    #[arg(long, hide = true, default_value_t = crate::offline::streamed::BLOCK_FRAMES)]
+    pub block_frames: usize,
 }
 
 /// `emoshift inspect`.

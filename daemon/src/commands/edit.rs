@@ -1,4 +1,6 @@
-//! `emoshift edit`: component-space edits of a take ([`crate::offline::edit`]).
+//! `emoshift edit`: component-space edits of a take ([`crate::offline::edit`]), streamed from
+//! file to output in blocks ([`crate::offline::streamed::edit_file`]) except Copy & Replace and
+//! Copy & Add, which align another take to the whole of this one and hold both in memory.
 
 use anyhow::{Context, Result};
 
@@ -31,15 +33,31 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
     inputs.extend(args.other_model.as_deref());
     offline::output::check_out(&args.out, &inputs, args.force)?;
     let model = offline::load_model(&args.model)?;
-    let take = offline::load_take(&args.file)?;
-    let out =
-        edit_take(&model, &args.model, &take, &args.file, &request).map_err(|e| match e
-            .downcast::<BadRequest>()
-        {
-            Ok(bad) => UsageError(bad.0).into(),
-            Err(e) => e,
-        })?;
-    replay::save(&args.out, &out).with_context(|| format!("{}", args.out.display()))?;
-    crate::out!("edited {} frames -> {}", out.n_frames(), args.out.display());
+    let frames = if request.replace_from.is_some() || request.add_from.is_some() {
+        let take = offline::load_take(&args.file)?;
+        let out = edit_take(&model, &args.model, &take, &args.file, &request).map_err(usage)?;
+        replay::save(&args.out, &out).with_context(|| format!("{}", args.out.display()))?;
+        out.n_frames()
+    } else {
+        let mut progress = super::progress::for_stderr("edit");
+        let done = offline::streamed::edit_file(
+            (&args.model, &model),
+            (&args.file, offline::takes::input_limit()),
+            &request,
+            &args.out,
+            args.block_frames,
+            progress.as_mut(),
+        );
+        super::progress::settle(progress.as_mut(), done).map_err(usage)?
+    };
+    crate::out!("edited {frames} frames -> {}", args.out.display());
     Ok(())
+}
+
+/// A [`BadRequest`] is the user's mistake: a usage error.
+fn usage(e: anyhow::Error) -> anyhow::Error {
+    match e.downcast::<BadRequest>() {
+        Ok(bad) => UsageError(bad.0).into(),
+        Err(e) => e,
+    }
 }

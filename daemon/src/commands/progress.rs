@@ -27,6 +27,19 @@ pub fn for_stderr(command: &'static str) -> Box<dyn Progress> {
     Box::new(Lines::new(command, std::io::stderr(), interval))
 }
 
+/// Ends the display of work that returned `result`: cleared when it succeeded, stopped
+/// without a final "done" line when it failed (the error is the one line that matters).
+///
+/// # Errors
+/// `result`'s error.
+pub fn settle<T>(progress: &mut dyn Progress, result: anyhow::Result<T>) -> anyhow::Result<T> {
+    match &result {
+        Ok(_) => progress.finish(),
+        Err(_) => progress.abandon(),
+    }
+    result
+}
+
 /// An indicatif bar per step (a spinner when the total is unknown).
 #[derive(Debug)]
 struct Bar {

@@ -132,16 +132,8 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     let started = Instant::now();
     let mut progress = super::progress::for_stderr("train");
     let trained = training::train_files(&paths, &options, &stream, progress.as_mut());
-    match trained {
-        Ok(trained) => {
-            progress.finish();
-            save_and_print(trained, paths.len(), &args.out, started).map(drop)
-        }
-        Err(e) => {
-            progress.abandon();
-            Err(e)
-        }
-    }
+    let trained = super::progress::settle(progress.as_mut(), trained)?;
+    save_and_print(trained, paths.len(), &args.out, started).map(drop)
 }
 
 /// Trains on `takes` held in memory, writes the model to `out` and prints what training

@@ -31,7 +31,8 @@ pub fn set_input_limit(bytes: u64) {
     INPUT_LIMIT.store(bytes, Ordering::Relaxed);
 }
 
-fn input_limit() -> u64 {
+/// The largest input file the offline commands read, bytes.
+pub fn input_limit() -> u64 {
     INPUT_LIMIT.load(Ordering::Relaxed)
 }
 

@@ -33,17 +33,25 @@ pub fn own(bytes: &[u8], l: &Layout) -> Samples {
         xyz: Vec::with_capacity(n * 3),
         invalid: Vec::with_capacity(n),
     };
-    let word = l.word();
     for f in 0..l.frames {
-        let frame = l.data_offset + f * l.frame_bytes();
-        for m in 0..l.points {
-            let at = frame + m * 4 * word;
-            let v = |k: usize| value(bytes, at + k * word, l);
-            s.xyz.extend([v(0), v(1), v(2)]);
-            s.invalid.push(residual_word(bytes, at + 3 * word, l) < 0);
-        }
+        let start = l.data_offset + f * l.frame_bytes();
+        let frame = bytes.get(start..).unwrap_or(&[]);
+        frame_into(frame, l, &mut s.xyz, &mut s.invalid);
     }
     s
+}
+
+/// Decodes one frame record (points then analog samples; only the points are read) and appends
+/// its xyz (file units) and residual signs: the one per-frame decoder of both the whole-file
+/// and the frame-block readers. Bytes past the end of `frame` read as an invalid zero sample.
+pub fn frame_into(frame: &[u8], l: &Layout, xyz: &mut Vec<f32>, invalid: &mut Vec<bool>) {
+    let word = l.word();
+    for m in 0..l.points {
+        let at = m * 4 * word;
+        let v = |k: usize| value(frame, at + k * word, l);
+        xyz.extend([v(0), v(1), v(2)]);
+        invalid.push(residual_word(frame, at + 3 * word, l) < 0);
+    }
 }
 
 fn value(bytes: &[u8], at: usize, l: &Layout) -> f32 {

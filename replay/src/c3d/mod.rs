@@ -14,6 +14,7 @@
 mod binary;
 mod decode;
 mod error;
+mod frames;
 mod layout;
 mod params;
 pub(crate) mod write;
@@ -23,6 +24,7 @@ use std::io::Read;
 pub use binary::Processor;
 pub use decode::Decoder;
 pub use error::{C3dError, C3dLimitError};
+pub use frames::C3dBlocks;
 pub use write::write;
 
 use crate::error::ReadError;
@@ -133,14 +135,21 @@ pub fn read_with_info(bytes: &[u8]) -> Result<(Take, C3dInfo), ReadError> {
     Ok((take, info))
 }
 
-/// Converts to millimetres and applies the missing rule: xyz exactly (0, 0, 0), a negative
-/// residual word, or a value that is not finite.
+/// Converts to millimetres and applies the missing rule ([`push_samples`]).
 fn build_take(l: &layout::Layout, xyz: &[f32], invalid: &[bool]) -> Take {
     let mut take = Take::new(l.labels.clone(), l.rate_hz, l.first_frame);
     take.source_units = l.units;
-    let to_mm = l.units.to_mm();
     take.positions.reserve(xyz.len());
     take.missing.reserve(invalid.len());
+    push_samples(l, xyz, invalid, &mut take);
+    take
+}
+
+/// Appends raw samples (file units) to `take` in millimetres, applying the missing rule: xyz
+/// exactly (0, 0, 0), a negative residual word, or a value that is not finite. Shared by the
+/// whole-file and frame-block readers so both give the same take.
+fn push_samples(l: &layout::Layout, xyz: &[f32], invalid: &[bool], take: &mut Take) {
+    let to_mm = l.units.to_mm();
     for (i, &bad) in invalid.iter().enumerate() {
         let p = &xyz[i * 3..i * 3 + 3];
         let gone = bad || p == [0.0; 3] || p.iter().any(|v| !v.is_finite());
@@ -151,5 +160,4 @@ fn build_take(l: &layout::Layout, xyz: &[f32], invalid: &[bool]) -> Take {
         }
         take.missing.push(gone);
     }
-    take
 }

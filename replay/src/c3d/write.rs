@@ -41,21 +41,61 @@ const MAX_PARAMETER_BLOCKS: usize = 255;
 pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
     take.validate()?;
     let frames = take.n_frames();
-    let range = FrameRange::new(take.first_frame, frames)?;
-    check_labels(&take.labels)?;
+    write_head(out, &take.labels, (take.rate_hz, take.first_frame), frames)?;
+    write_frames(out, take, &mut Vec::new())?;
+    write_padding(out, frames, take.n_markers())
+}
+
+/// Header and parameter section of a take of `frames` frames: everything before the first
+/// frame.
+///
+/// # Errors
+/// What C3D cannot hold (no frames, too many markers, a long label, a first frame outside
+/// 0..=65535), or an I/O error.
+pub(crate) fn write_head(
+    out: &mut impl Write,
+    labels: &[String],
+    (rate_hz, first_frame): (f64, i64),
+    frames: usize,
+) -> Result<(), WriteError> {
+    let range = FrameRange::new(first_frame, frames)?;
+    check_labels(labels)?;
     let meta = Meta {
-        labels: &take.labels,
-        rate_hz: take.rate_hz,
+        labels,
+        rate_hz,
         time: None,
     };
     let blocks = parameter_blocks(&meta, &range)?;
     out.write_all(&head(&meta, &range, blocks))?;
-    let mut buf = Vec::with_capacity(meta.labels.len() * 16);
-    for f in 0..frames {
-        encode_frame(take.frame(f), take.frame_missing(f), &mut buf);
-        out.write_all(&buf)?;
+    Ok(())
+}
+
+/// Every frame of `take` as records, `buf` reused.
+///
+/// # Errors
+/// An I/O error.
+pub(crate) fn write_frames(
+    out: &mut impl Write,
+    take: &Take,
+    buf: &mut Vec<u8>,
+) -> std::io::Result<()> {
+    for f in 0..take.n_frames() {
+        encode_frame(take.frame(f), take.frame_missing(f), buf);
+        out.write_all(buf)?;
     }
-    out.write_all(&vec![0u8; padding(frames, meta.labels.len())])?;
+    Ok(())
+}
+
+/// The zero padding after the last of `frames` frames.
+///
+/// # Errors
+/// An I/O error.
+pub(crate) fn write_padding(
+    out: &mut impl Write,
+    frames: usize,
+    markers: usize,
+) -> Result<(), WriteError> {
+    out.write_all(&vec![0u8; padding(frames, markers)])?;
     Ok(())
 }
 

@@ -33,110 +33,27 @@
 
 mod header;
 mod rate;
+mod rows;
 
 use std::io::{BufReader, Read, Write};
 
-use self::header::{parse_comment, parse_header, Meta};
+pub use self::rows::CsvBlocks;
 use crate::error::{ReadError, WriteError};
-use crate::trc::text::{self, check_frame_number, parse_time, Lines};
-use crate::{Take, Units};
+use crate::trc::text;
+use crate::Take;
 
-/// Reads a CSV take (values converted to millimetres).
+/// Reads a CSV take (values converted to millimetres): the block reader run to the end.
 ///
 /// # Errors
 /// I/O failure, malformed content (see the module docs for each rule), unknown units, no
 /// derivable rate, or a take that breaks a [`Take`] invariant (no markers, duplicate labels).
 pub fn read(input: impl Read) -> Result<Take, ReadError> {
-    let mut lines = Lines::new(BufReader::new(input));
-    let mut meta = Meta::default();
-    let (labels, extra) = loop {
-        let line = lines.next_number();
-        match lines.next_non_blank()? {
-            Some((n, text)) if text.trim_start().starts_with('#') => {
-                parse_comment(n, text, &mut meta)?;
-            }
-            Some((n, text)) => break parse_header(n, text)?,
-            None => {
-                let expected = "the `frame,time,<label>_x,<label>_y,<label>_z,...` header";
-                return Err(ReadError::UnexpectedEnd { line, expected });
-            }
-        }
-    };
-    let units = meta.units.unwrap_or(Units::Millimetres);
-    let mut take = Take::new(labels, meta.rate_hz.unwrap_or(1.0), 1);
-    take.source_units = units;
-    let rows = read_rows(&mut lines, &mut take, meta.rate_hz.is_none(), extra)?;
-    if let Some(first) = rows.first_frame {
-        take.first_frame = first;
-    }
-    if meta.rate_hz.is_none() {
-        take.rate_hz = rate::derive_rate(&rows.times, rows.resolution_s)?;
-    }
+    let mut blocks = CsvBlocks::new(BufReader::new(input))?;
+    let mut take = blocks.header().empty_take();
+    blocks.read_block(usize::MAX, &mut take)?;
+    take.rate_hz = blocks.rate_hz()?;
     take.validate()?;
     Ok(take)
-}
-
-/// What the data rows tell beyond the samples.
-struct Rows {
-    first_frame: Option<i64>,
-    /// `(line, time_s)` per row, collected only when the rate must be derived.
-    times: Vec<(usize, f64)>,
-    /// The time column's last decimal place, seconds (0 when written with exponents).
-    resolution_s: f64,
-}
-
-/// Reads every data row into `take` (whose labels and units are set).
-fn read_rows<R: std::io::BufRead>(
-    lines: &mut Lines<R>,
-    take: &mut Take,
-    keep_times: bool,
-    extra: usize,
-) -> Result<Rows, ReadError> {
-    let n = take.n_markers();
-    let width = 2 + extra + 3 * n;
-    let scale = f64::from(take.source_units.to_mm());
-    let (mut xyz, mut gone) = (vec![0.0f32; 3 * n], vec![false; n]);
-    let mut rows = Rows {
-        first_frame: None,
-        times: Vec::new(),
-        resolution_s: 1.0,
-    };
-    let mut max_decimals = Some(0u32);
-    let mut next_frame = None;
-    while let Some((line, row)) = lines.next_non_blank()? {
-        let cells: Vec<&str> = row.split(',').collect();
-        if cells.len() != width {
-            let found = cells.len();
-            return Err(ReadError::ColumnCount {
-                line,
-                expected: width,
-                found,
-            });
-        }
-        let frame = check_frame_number(cells[0], line, next_frame, "frame")?;
-        rows.first_frame.get_or_insert(frame);
-        next_frame = Some(frame.wrapping_add(1));
-        let time_s = parse_time(cells[1])
-            .ok_or_else(|| text::bad_cell(line, 1, "time", "a time in seconds", cells[1]))?;
-        if keep_times {
-            rows.times.push((line, time_s));
-            max_decimals = max_decimals
-                .zip(rate::decimals(cells[1]))
-                .map(|(a, b)| a.max(b));
-        }
-        text::parse_samples(
-            line,
-            &cells[2 + extra..],
-            2 + extra,
-            &take.labels,
-            scale,
-            &mut xyz,
-            &mut gone,
-        )?;
-        take.push_frame(&xyz, &gone);
-    }
-    rows.resolution_s = max_decimals.map_or(0.0, |d| 10f64.powi(-(d.min(300) as i32)));
-    Ok(rows)
 }
 
 /// Writes a CSV take in millimetres, with a `# rate_hz=... units=mm` comment line first.
@@ -147,10 +64,26 @@ fn read_rows<R: std::io::BufRead>(
 /// label is rejected.
 pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
     take.validate()?;
-    text::check_labels(&take.labels, "csv", &[',', '"', '\n', '\r'])?;
-    writeln!(out, "# rate_hz={} units=mm", take.rate_hz)?;
+    check_labels(&take.labels)?;
+    write_header(out, &take.labels, take.rate_hz)?;
+    text::write_rows(out, take, (take.first_frame, 0), ',', &mut String::new())?;
+    Ok(())
+}
+
+/// Rejects labels CSV cannot hold (a comma, a double quote, a line break).
+pub(crate) fn check_labels(labels: &[String]) -> Result<(), WriteError> {
+    text::check_labels(labels, "csv", &[',', '"', '\n', '\r'])
+}
+
+/// The rate comment and the column header.
+pub(crate) fn write_header(
+    out: &mut impl Write,
+    labels: &[String],
+    rate_hz: f64,
+) -> std::io::Result<()> {
+    writeln!(out, "# rate_hz={rate_hz} units=mm")?;
     let mut line = String::from("frame,time");
-    for label in &take.labels {
+    for label in labels {
         for axis in ["x", "y", "z"] {
             line.push(',');
             line.push_str(label);
@@ -158,11 +91,5 @@ pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
             line.push_str(axis);
         }
     }
-    writeln!(out, "{line}")?;
-    for f in 0..take.n_frames() {
-        line.clear();
-        text::write_row(&mut line, take, f, ',');
-        out.write_all(line.as_bytes())?;
-    }
-    Ok(())
+    writeln!(out, "{line}")
 }

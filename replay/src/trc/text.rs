@@ -248,12 +248,19 @@ pub(crate) fn check_labels(
     Ok(())
 }
 
-/// Formats frame index `f` of `take` as one row — frame number, time, then x y z per marker,
-/// empty cells for a missing sample — separated by `sep` and ending in a newline.
-pub(crate) fn write_row(line: &mut String, take: &crate::Take, f: usize, sep: char) {
+/// Formats frame index `f` of `take` as one row — frame `number`, `time` (seconds from the
+/// take's first frame), then x y z per marker, empty cells for a missing sample — separated by
+/// `sep` and ending in a newline. The caller numbers the row so a take written in blocks gets
+/// the numbers and times the whole take would.
+pub(crate) fn write_row(
+    line: &mut String,
+    take: &crate::Take,
+    f: usize,
+    (number, time): (i64, f64),
+    sep: char,
+) {
     use std::fmt::Write as _;
-    let frame = take.first_frame.wrapping_add(f as i64);
-    write!(line, "{frame}{sep}{:.6}", take.time_of(f)).expect("writing to a String cannot fail");
+    write!(line, "{number}{sep}{time:.6}").expect("writing to a String cannot fail");
     for m in 0..take.n_markers() {
         match take.sample(f, m) {
             Some(p) => {
@@ -270,6 +277,28 @@ pub(crate) fn write_row(line: &mut String, take: &crate::Take, f: usize, sep: ch
         }
     }
     line.push('\n');
+}
+
+/// Writes every frame of `take` as rows numbered from frame index `index` of a take that
+/// starts at frame `first_frame`, reusing `line`.
+///
+/// # Errors
+/// I/O failure.
+pub(crate) fn write_rows(
+    out: &mut impl std::io::Write,
+    take: &crate::Take,
+    (first_frame, index): (i64, usize),
+    sep: char,
+    line: &mut String,
+) -> std::io::Result<()> {
+    for f in 0..take.n_frames() {
+        let i = index + f;
+        line.clear();
+        let at = (first_frame.wrapping_add(i as i64), i as f64 / take.rate_hz);
+        write_row(line, take, f, at, sep);
+        out.write_all(line.as_bytes())?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -23,8 +23,10 @@ use ica_core::model::IcaModel;
 use ica_core::project::Projector;
 use replay::Take;
 
+mod output;
+
+pub(crate) use self::output::Output;
 use crate::engine::edit_state::EditState;
-use crate::engine::LabelMap;
 use crate::offline::analysis::DTW_BAND_SHARE;
 use crate::offline::{self, ModelFrames, Projected};
 
@@ -140,7 +142,7 @@ fn aligned_components(this: &Projected, other: &Projected, ks: &[usize]) -> Resu
 type Series = Vec<(usize, Vec<f64>)>;
 
 /// The per-frame edit plan.
-struct Plan {
+pub(crate) struct Plan {
     offsets: Vec<f32>,
     gains: Vec<f32>,
     /// Components replaced by a value per frame each.
@@ -149,15 +151,47 @@ struct Plan {
     add: Option<(IcaModel, Series)>,
     /// The live emotion edit (causal low-pass), when `--lowpass` asks for it.
     live: Option<EditState>,
+    /// `--to-emotion` from the take's mean: the emotion components, the point and how far;
+    /// waits for the take's component sums ([`Plan::settle`]).
+    toward: Option<(Vec<usize>, Vec<f32>, f32)>,
 }
 
-fn plan(
-    request: &EditRequest,
-    model_path: &Path,
-    model: &IcaModel,
-    projected: &Projected,
-    frames: &ModelFrames,
-) -> Result<Plan> {
+/// Sums of each component over a take's frames, in frame order, for the take's mean: the one
+/// accumulation of the whole-take and the streaming edits, so their means are the same bits.
+#[derive(Debug, Clone)]
+pub(crate) struct ComponentSums {
+    sums: Vec<f64>,
+    frames: usize,
+}
+
+impl ComponentSums {
+    pub(crate) fn new(components: usize) -> Self {
+        // -0.0 is the identity of float addition, as in `Iterator::sum`.
+        ComponentSums {
+            sums: vec![-0.0; components],
+            frames: 0,
+        }
+    }
+
+    /// Adds one frame's components.
+    pub(crate) fn add(&mut self, u: &[f32]) {
+        for (s, &v) in self.sums.iter_mut().zip(u) {
+            *s += f64::from(v);
+        }
+        self.frames += 1;
+    }
+
+    fn mean(&self, k: usize) -> f32 {
+        (self.sums[k] / self.frames.max(1) as f64) as f32
+    }
+}
+
+/// Checks a request against the model and plans what needs no take: the raw edits, the live
+/// emotion edit, and the target of a mean-based one.
+///
+/// # Errors
+/// A [`BadRequest`], or a model without an emotion space when the request needs one.
+pub(crate) fn plan(request: &EditRequest, model_path: &Path, model: &IcaModel) -> Result<Plan> {
     let m = model.components();
     let mut plan = Plan {
         offsets: vec![0.0; m],
@@ -165,6 +199,7 @@ fn plan(
         replace: Vec::new(),
         add: None,
         live: None,
+        toward: None,
     };
     for &(k, v) in &request.translate {
         plan.offsets[check_component(model, k, v, "--translate")?] += v as f32;
@@ -179,71 +214,134 @@ fn plan(
         if !(0.0..=1.0).contains(&amount) {
             return Err(BadRequest(format!("--amount {amount} is outside 0..1")).into());
         }
+        let goal: Vec<f32> = point.iter().map(|&v| v as f32).collect();
         match request.lowpass_s {
             // The live daemon's edit: towards the point from a causal low-pass of each emotion
             // component, exactly as `serve` does with a zero ramp.
             Some(window) => {
                 let mut state = EditState::for_model(model, window as f32);
                 state.set_ramp(0.0);
-                let p: Vec<f32> = point.iter().map(|&v| v as f32).collect();
-                state.set_target(&name, &p)?;
+                state.set_target(&name, &goal)?;
                 state.set_amount(amount as f32)?;
                 plan.live = Some(state);
             }
-            None => {
-                let n = frames.frames().max(1) as f64;
-                let current: Vec<f32> = space
-                    .iter()
-                    .map(|&k| (projected.component(k).iter().sum::<f64>() / n) as f32)
-                    .collect();
-                let goal: Vec<f32> = point.iter().map(|&v| v as f32).collect();
-                let mut to = vec![0.0f32; space.len()];
-                ica_core::model::SpaceTarget::new(model.emotion())
-                    .target_into(&current, &goal, &mut to);
-                for ((&k, c), t) in space.iter().zip(&current).zip(&to) {
-                    plan.offsets[k] += (amount as f32) * (t - c);
-                }
-            }
+            None => plan.toward = Some((space, goal, amount as f32)),
         }
-    }
-    if let Some(other) = &request.replace_from {
-        // The emotion axes take the other take's series (the paper's Copy & Replace); the
-        // other emotion components also follow what is said, so they only take the other
-        // take's level: their own motion stays.
-        let space = emotion_components(model, model_path)?;
-        let (axes, shifted): (Vec<usize>, Vec<usize>) = space
-            .iter()
-            .partition(|&&k| model.roles()[k] == ica_core::model::Role::Emotion);
-        let other_u = project_other(model, other)?;
-        let series = aligned_components(projected, &other_u, &axes)?;
-        plan.replace = axes.into_iter().zip(series).collect();
-        for k in shifted {
-            let mean = |p: &Projected| {
-                p.component(k).iter().sum::<f64>() / p.component(k).len().max(1) as f64
-            };
-            plan.offsets[k] += (mean(&other_u) - mean(projected)) as f32;
-        }
-    }
-    if let Some((other, path)) = &request.add_from {
-        let model2 = crate::offline::load_model(path)?;
-        if model2.labels() != model.labels() {
-            bail!(
-                "{}: Copy & Add needs both models to have the same markers in the same order",
-                path.display()
-            );
-        }
-        let space2 = emotion_components(&model2, path)?;
-        let this2 = offline::project_take(&model2, frames)?;
-        let other_u = project_other(&model2, other)?;
-        let series = aligned_components(&this2, &other_u, &space2)?;
-        plan.add = Some((model2, space2.into_iter().zip(series).collect()));
     }
     Ok(plan)
 }
 
+impl Plan {
+    /// Whether the plan needs the take's component means ([`Plan::settle`]) before editing.
+    pub(crate) fn needs_means(&self) -> bool {
+        self.toward.is_some()
+    }
+
+    /// Turns a mean-based `--to-emotion` into offsets, from the take's component sums.
+    pub(crate) fn settle(&mut self, model: &IcaModel, sums: &ComponentSums) {
+        let Some((space, goal, amount)) = self.toward.take() else {
+            return;
+        };
+        let current: Vec<f32> = space.iter().map(|&k| sums.mean(k)).collect();
+        let mut to = vec![0.0f32; space.len()];
+        ica_core::model::SpaceTarget::new(model.emotion()).target_into(&current, &goal, &mut to);
+        for ((&k, c), t) in space.iter().zip(&current).zip(&to) {
+            self.offsets[k] += amount * (t - c);
+        }
+    }
+
+    /// Copy & Replace and Copy & Add, which align another take to the whole of this one.
+    fn copies(
+        &mut self,
+        request: &EditRequest,
+        (model_path, model): (&Path, &IcaModel),
+        projected: &Projected,
+        frames: &ModelFrames,
+    ) -> Result<()> {
+        if let Some(other) = &request.replace_from {
+            // The emotion axes take the other take's series (the paper's Copy & Replace); the
+            // other emotion components also follow what is said, so they only take the other
+            // take's level: their own motion stays.
+            let space = emotion_components(model, model_path)?;
+            let (axes, shifted): (Vec<usize>, Vec<usize>) = space
+                .iter()
+                .partition(|&&k| model.roles()[k] == ica_core::model::Role::Emotion);
+            let other_u = project_other(model, other)?;
+            let series = aligned_components(projected, &other_u, &axes)?;
+            self.replace = axes.into_iter().zip(series).collect();
+            for k in shifted {
+                let mean = |p: &Projected| {
+                    p.component(k).iter().sum::<f64>() / p.component(k).len().max(1) as f64
+                };
+                self.offsets[k] += (mean(&other_u) - mean(projected)) as f32;
+            }
+        }
+        if let Some((other, path)) = &request.add_from {
+            let model2 = crate::offline::load_model(path)?;
+            if model2.labels() != model.labels() {
+                bail!(
+                    "{}: Copy & Add needs both models to have the same markers in the same order",
+                    path.display()
+                );
+            }
+            let space2 = emotion_components(&model2, path)?;
+            let this2 = offline::project_take(&model2, frames)?;
+            let other_u = project_other(&model2, other)?;
+            let series = aligned_components(&this2, &other_u, &space2)?;
+            self.add = Some((model2, space2.into_iter().zip(series).collect()));
+        }
+        Ok(())
+    }
+
+    /// The per-frame editor of this plan.
+    ///
+    /// # Errors
+    /// An offset or gain the edit refuses (not finite).
+    pub(crate) fn editor(&mut self, model: &IcaModel) -> Result<FrameEditor> {
+        let mut edit = FrameEdit::identity(model.components());
+        for k in 0..self.offsets.len() {
+            edit.set_offset(k, self.offsets[k])?;
+            edit.set_gain(k, self.gains[k])?;
+        }
+        Ok(FrameEditor {
+            edit,
+            live: self.live.take(),
+            dt: (1.0 / model.rate_hz()) as f32,
+            replace: std::mem::take(&mut self.replace),
+        })
+    }
+}
+
+/// Edits one frame's components after another: the state that crosses frames (the live
+/// edit's low-pass) lives here, so a take edited in blocks gets the whole take's edit.
+pub(crate) struct FrameEditor {
+    edit: FrameEdit,
+    live: Option<EditState>,
+    dt: f32,
+    replace: Series,
+}
+
+impl FrameEditor {
+    /// Edits the components `u` of frame index `f` (counted from the take's first frame).
+    ///
+    /// # Errors
+    /// A replaced value the edit refuses.
+    pub(crate) fn apply(&mut self, f: usize, u: &mut [f32]) -> Result<()> {
+        for (k, values) in &self.replace {
+            self.edit.set_override(*k, Some(values[f] as f32))?;
+        }
+        self.edit.apply(u)?;
+        if let Some(state) = self.live.as_mut() {
+            state.apply(self.dt, u);
+        }
+        Ok(())
+    }
+}
+
 /// Edits `take` under `model` (read from `model_path`, named in errors) as `request` asks and
-/// returns the edited take:
-/// the model's markers edited (gaps filled from the model unless `keep_gaps`), then the
+/// returns the edited take, holding it whole: the path of Copy & Replace and Copy & Add, which
+/// align another take to all of this one ([`crate::offline::streamed`] edits the rest).
+/// The model's markers edited (gaps filled from the model unless `keep_gaps`), then the
 /// take's extra markers unchanged.
 ///
 /// # Errors
@@ -256,27 +354,18 @@ pub fn edit_take(
     take_path: &Path,
     request: &EditRequest,
 ) -> Result<Take> {
+    let mut plan = plan(request, model_path, model)?;
     let map = offline::match_take(model, take, take_path)?;
     let frames = offline::to_model_order(take, &map);
     let projected = offline::project_take(model, &frames)?;
-    let mut plan = plan(request, model_path, model, &projected, &frames)?;
-    let mut frame_edit = FrameEdit::identity(model.components());
-    for k in 0..plan.offsets.len() {
-        frame_edit.set_offset(k, plan.offsets[k])?;
-        frame_edit.set_gain(k, plan.gains[k])?;
+    let mut sums = ComponentSums::new(model.components());
+    for u in projected.u.chunks_exact(projected.m) {
+        sums.add(u);
     }
-    let mut live = plan.live.take();
-    let dt = (1.0 / model.rate_hz()) as f32;
-    let mut edited = offline::resynthesise(model, &projected, |f, u| {
-        for (k, values) in &plan.replace {
-            frame_edit.set_override(*k, Some(values[f] as f32))?;
-        }
-        frame_edit.apply(u)?;
-        if let Some(state) = live.as_mut() {
-            state.apply(dt, u);
-        }
-        Ok(())
-    })?;
+    plan.settle(model, &sums);
+    plan.copies(request, (model_path, model), &projected, &frames)?;
+    let mut editor = plan.editor(model)?;
+    let mut edited = offline::resynthesise(model, &projected, |f, u| editor.apply(f, u))?;
     if let Some((model2, added)) = &plan.add {
         let second = Projector::new(model2);
         let channels = model.channels();
@@ -286,51 +375,13 @@ pub fn edit_take(
             }
         }
     }
-    assemble(
-        take,
-        model.labels(),
-        &map,
-        &frames,
-        edited,
-        request.keep_gaps,
-    )
-}
-
-/// The output take: the model's markers edited (gaps filled from the model unless `keep_gaps`),
-/// followed by the take's extra markers unchanged, so nothing the user gave is lost.
-fn assemble(
-    take: &Take,
-    model_labels: &[String],
-    map: &LabelMap,
-    frames: &ModelFrames,
-    edited: Vec<f32>,
-    keep_gaps: bool,
-) -> Result<Take> {
-    let model_markers = map.model_to_take.len();
-    let mut labels: Vec<String> = Vec::with_capacity(model_markers + map.extra.len());
-    labels.extend_from_slice(model_labels);
-    labels.extend(map.extra.iter().map(|&t| take.labels[t].clone()));
-    let mut out = Take::new(labels, take.rate_hz, take.first_frame);
-    out.source_units = take.source_units;
-    let width = out.n_markers();
-    let mut xyz = vec![0.0f32; width * 3];
-    let mut missing = vec![false; width];
+    let mut out = Output::new(take, model.labels(), &map);
+    let n = map.model_to_take.len();
     for f in 0..take.n_frames() {
         let (_, model_missing) = frames.frame(f);
-        xyz[..model_markers * 3]
-            .copy_from_slice(&edited[f * model_markers * 3..(f + 1) * model_markers * 3]);
-        for i in 0..model_markers {
-            missing[i] = keep_gaps && model_missing[i];
-        }
-        for (j, &t) in map.extra.iter().enumerate() {
-            let slot = model_markers + j;
-            xyz[slot * 3..slot * 3 + 3].copy_from_slice(&take.frame(f)[t * 3..t * 3 + 3]);
-            missing[slot] = take.is_missing(f, t);
-        }
-        if xyz.iter().any(|v| !v.is_finite()) {
-            bail!("frame {f}: the edit produced a non-finite position");
-        }
-        out.push_frame(&xyz, &missing);
+        let edited = &edited[f * n * 3..(f + 1) * n * 3];
+        let source = (take.frame(f), take.frame_missing(f));
+        out.push_frame(f, source, (edited, model_missing), request.keep_gaps)?;
     }
-    Ok(out)
+    Ok(out.take)
 }

@@ -1,0 +1,107 @@
+//! `project` and `edit` from the take file to the output in blocks of frames, so memory holds
+//! a block and the model whatever the take's length (issue 18). Every frame goes through the
+//! same [`FrameProcessor`] in order, whose state (glitch reference, held pose, held
+//! components) crosses block boundaries untouched, so the output is the whole-take path's.
+//!
+//! - [`project_file`]: one pass.
+//! - [`edit_file`]: one pass, or two for `--to-emotion` without `--lowpass`, whose offset needs
+//!   the take's mean components (the first pass sums them; the file is read again).
+//! - Copy & Replace and Copy & Add align another take to all of this one (DTW) and stay on the
+//!   whole-take path ([`crate::offline::edit::edit_take`]).
+//! - A CSV without `# rate_hz=` only has a rate once its last row is read: it is loaded whole
+//!   and then processed in the same blocks.
+//!
+//! Outputs are written to a hidden file beside the output and renamed over it when complete:
+//! a failure half way (a truncated input) leaves no partial file.
+
+mod edit;
+mod output;
+mod project;
+mod source;
+
+pub use edit::edit_file;
+pub use project::{project_file, ProjectSummary};
+
+use anyhow::{Context, Result};
+use ica_core::model::IcaModel;
+
+use crate::engine::frame::{FrameProcessor, Prepared};
+use crate::engine::LabelMap;
+use crate::offline::progress::Progress;
+use crate::offline::takes::frames_in_model_order;
+pub(crate) use output::PendingOut;
+pub(crate) use source::Source;
+
+/// Frames per block: a few megabytes for a hundred markers, enough to amortise each block's
+/// bookkeeping.
+pub const BLOCK_FRAMES: usize = 4096;
+
+/// One frame as a [`FrameSink`] sees it, projected.
+pub(crate) struct Frame<'a> {
+    /// Frame index from the take's first frame.
+    pub index: usize,
+    /// The frame as read (take markers), with its mask.
+    pub source: (&'a [f32], &'a [bool]),
+    /// The frame in model order, with its mask.
+    pub model: (&'a [f32], &'a [bool]),
+    /// What preparing and projecting found.
+    pub prepared: Prepared,
+    /// The components, for the sink to use or edit.
+    pub u: &'a mut [f32],
+}
+
+/// What a pass does with each projected frame, and after each block.
+pub(crate) trait FrameSink {
+    /// One frame, in take order.
+    fn frame(&mut self, frame: Frame<'_>) -> Result<()>;
+    /// The block's frames are all seen.
+    fn end_block(&mut self) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// Matches a source's labels to a model's.
+fn label_map(model: &IcaModel, source: &Source) -> Result<LabelMap> {
+    LabelMap::new(model.labels(), source.labels())
+        .with_context(|| format!("{}", source.path().display()))
+}
+
+/// Projects every frame of `source` in blocks of `block_frames` and hands it to `sink`;
+/// reports progress as step `name`; returns the frames seen.
+///
+/// # Errors
+/// The source's read errors (naming the file), or the sink's.
+pub(crate) fn run_pass(
+    model: &IcaModel,
+    (source, map): (&mut Source, &LabelMap),
+    block_frames: usize,
+    (progress, name): (&mut dyn Progress, &str),
+    sink: &mut dyn FrameSink,
+) -> Result<usize> {
+    progress.step(name, "frames", source.frames().map(|n| n as u64));
+    let mut processor = FrameProcessor::new(model);
+    let mut block = source.empty_take();
+    let mut u = vec![0.0f32; model.components()];
+    let mut index = 0;
+    while source.read_block(block_frames.max(1), &mut block)? > 0 {
+        let frames = frames_in_model_order(&block, map, 0..block.n_frames());
+        for k in 0..block.n_frames() {
+            let (xyz, missing) = frames.frame(k);
+            let prepared = processor.project(xyz, missing, &mut u)?;
+            sink.frame(Frame {
+                index: index + k,
+                source: (block.frame(k), block.frame_missing(k)),
+                model: (xyz, missing),
+                prepared,
+                u: &mut u,
+            })?;
+        }
+        index += block.n_frames();
+        sink.end_block()?;
+        progress.advance(block.n_frames() as u64);
+    }
+    if index == 0 {
+        anyhow::bail!("{}: take has no frames", source.path().display());
+    }
+    Ok(index)
+}
