@@ -17,6 +17,7 @@
 //!   the emotion set need not be known while the takes stream past.
 //! - [`label`]: roles from the metrics, with the thresholds in [`LabelRules`].
 
+mod anova;
 mod distance;
 mod effect;
 
