@@ -2,7 +2,10 @@
 //! in memory (every take loaded and projected at once, every pair aligned together), on a
 //! synthetic session of several sentences in four emotions whose manifest interleaves the
 //! sentences (so the streamed sums run in another order), with a TRC and a CSV take among the
-//! C3D ones (headers that declare their length, and one that does not).
+//! C3D ones (headers that declare their length, and one that does not). One take is warped
+//! in time far from the diagonal and another is three times the others' length: the DTW band,
+//! a share of the session's longest take, binds on the warped take's pairs only if a
+//! sentence's band came from that sentence alone.
 
 mod common;
 
@@ -13,6 +16,7 @@ use daemon::offline::analysis::{self, Inputs};
 use daemon::offline::progress::Silent;
 use daemon::offline::{self};
 use replay::synth::{generate_session, SynthParams};
+use replay::Take;
 use serde_json::Value;
 
 /// Relative tolerance on every number of the report. `d_region,i` is a difference of two
@@ -34,6 +38,17 @@ fn session(dir: &Path, sentences: usize) -> (std::path::PathBuf, std::path::Path
         ..SynthParams::default()
     };
     let mut s = generate_session(&params, replay::Format::C3d).expect("session");
+    s.takes[1] = warped(&s.takes[1]);
+    let last = s.takes.len() - 1;
+    s.takes[last] = [&s.takes[last]; 3].map(|t| t.clone()).into_iter().fold(
+        Take::new(s.takes[last].labels.clone(), s.takes[last].rate_hz, 1),
+        |mut long, t| {
+            for f in 0..t.n_frames() {
+                long.push_frame(t.frame(f), t.frame_missing(f));
+            }
+            long
+        },
+    );
     for (i, (take, entry)) in s.takes.iter().zip(&mut s.session.takes).enumerate() {
         // One TRC and one CSV take: declared and undeclared lengths.
         let ext = match i {
@@ -53,6 +68,18 @@ fn session(dir: &Path, sentences: usize) -> (std::path::PathBuf, std::path::Path
     let (m, mf) = (p(&model), p(&manifest));
     ok(&["train", "--manifest", mf, "--out", m, "--components", "10"]);
     (manifest, model)
+}
+
+/// `take` at twice its speed for its first half, then at half its speed: far from the
+/// diagonal of an alignment with the same sentence at an even pace.
+fn warped(take: &Take) -> Take {
+    let n = take.n_frames();
+    let mut out = Take::new(take.labels.clone(), take.rate_hz, take.first_frame);
+    let frames = (0..n / 2).step_by(2).chain((n / 2..n).flat_map(|f| [f, f]));
+    for f in frames {
+        out.push_frame(take.frame(f), take.frame_missing(f));
+    }
+    out
 }
 
 /// Every number of `a` within [`REL`] of `b`'s, everything else equal.
