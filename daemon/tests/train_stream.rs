@@ -115,29 +115,23 @@ fn issue_18_train_shows_progress_in_a_pipe() {
     let dir = tempfile::tempdir().expect("temp dir");
     let model = dir.path().join("model.json");
     let take = facial_sing().remove(0);
-    // Every step's line at once: a run this short is otherwise quiet (lines every 5 s).
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_emoshift"))
-        .args([
-            "train",
-            "--stream",
-            "--threads",
-            "1",
-            "--out",
-            s(&model),
-            s(&take),
-        ])
-        .env("EMOSHIFT_PROGRESS_SECS", "0")
-        .output()
-        .expect("emoshift runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
-    for line in [
-        "train: reading takes done: 1 takes in ",
-        "train: statistics done: ",
-        "train: whitening done: ",
-        " FastICA restarts on ",
-    ] {
-        assert!(err.contains(line), "no {line:?} in:\n{err}");
-    }
+    let args = [
+        "train",
+        "--stream",
+        "--threads",
+        "1",
+        "--out",
+        s(&model),
+        s(&take),
+    ];
+    common::shows_progress(
+        &args,
+        &[
+            "train: reading takes done: 1 takes in ",
+            "train: statistics done: ",
+            "train: whitening done: ",
+            " FastICA restarts on ",
+        ],
+    );
     assert!(std::fs::metadata(&model).is_ok());
 }

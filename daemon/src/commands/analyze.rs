@@ -43,15 +43,16 @@ pub(crate) fn analyze_and_write(
         None => session.base_dir.join("regions.toml"),
     };
     let regions = analysis::resolve_regions(&regions_path, &model)?;
-    let takes = analysis::project_session(&model, &session)?;
     let inputs = Inputs {
         model: &model,
         model_path,
         manifest_path: manifest,
         regions_path: &regions_path,
     };
-    let report = analysis::analyze(&inputs, &takes, &regions)?;
-    let written = analysis::write_report(to.dir, &report, &takes)?;
+    let mut progress = super::progress::for_stderr("analyze");
+    let done = analysis::analyze_session(&inputs, &session, &regions, progress.as_mut());
+    let (report, timeline) = super::progress::settle(progress.as_mut(), done)?;
+    let written = analysis::write_report(to.dir, &report, &timeline)?;
     for c in &report.components {
         crate::out!(
             "c{:<2} {:<9} d_emotion {:>8} d_level {:>8} d_mouth {:>8.4} d_eyebrows {:>8.4} d_eyelids {:>8.4}",

@@ -24,6 +24,22 @@ pub fn ok(args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// Runs `emoshift` with a progress line for every step and advance (as in a pipe, without
+/// the interval that keeps a short run quiet), fails the test if it fails, and checks that
+/// stderr holds each of `lines`.
+pub fn shows_progress(args: &[&str], lines: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_emoshift"))
+        .args(args)
+        .env("EMOSHIFT_PROGRESS_SECS", "0")
+        .output()
+        .expect("emoshift runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    for line in lines {
+        assert!(err.contains(line), "no {line:?} in:\n{err}");
+    }
+}
+
 /// A path as a command-line argument.
 pub fn p(path: &Path) -> &str {
     path.to_str().expect("utf-8 path")

@@ -12,12 +12,16 @@
 //! paired information and are left out. With two emotions this is the paired t-test on the
 //! differences of take means, squared. Speech, blinks and noise average out over a take or
 //! differ by sentence (the blocks absorb that); emotion shifts a component's level for a whole
-//! take. A component belongs to the emotion subspace when its p-value is below
+//! take. The fits use the block structure rather than dummy design matrices ([`super::anova`]),
+//! so their cost grows with the takes, not with takes times sentences. A component belongs to
+//! the emotion subspace when its p-value is below
 //! [`EMOTION_ALPHA`] divided by the number of components tested (Bonferroni).
 
 use std::collections::BTreeMap;
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
+
+use super::anova::Blocks;
 use serde::{Deserialize, Serialize};
 
 /// Family-wise error rate of the emotion test over all components.
@@ -88,30 +92,21 @@ pub fn emotion_effects(takes: &[TakeMeans<'_>], m: usize) -> Vec<EmotionEffect> 
         return vec![none; m];
     }
     let df_error = n - s - e + 1;
-    // Design columns: intercept, S − 1 sentence dummies, then E − 1 emotion dummies.
-    let design = |with_sentence: bool, with_emotion: bool| {
-        let sent = if with_sentence { s - 1 } else { 0 };
-        let cols = 1 + sent + if with_emotion { e - 1 } else { 0 };
-        DMatrix::from_fn(n, cols, |r, c| {
-            let t = used[r];
-            match c {
-                0 => 1.0,
-                c if c <= sent => f64::from(u8::from(sentences[c] == t.sentence)),
-                c => f64::from(u8::from(emotions[c - sent] == t.emotion)),
-            }
-        })
-    };
-    let (full, reduced, emotion_only) =
-        (design(true, true), design(true, false), design(false, true));
+    let (s_at, e_at) = (index_of(&sentences), index_of(&emotions));
+    let blocks = Blocks::new(
+        used.iter().map(|t| s_at[t.sentence]).collect(),
+        used.iter().map(|t| e_at[t.emotion]).collect(),
+        s,
+        e,
+    );
     let per_sentence = n as f64 / s as f64;
     (0..m)
         .map(|k| {
             let y = DVector::from_fn(n, |r, _| used[r].means[k]);
-            let (Some(rss1), Some(rss0), Some(rss_e)) =
-                (rss(&full, &y), rss(&reduced, &y), rss(&emotion_only, &y))
-            else {
+            let Some(fits) = blocks.fit(y.as_slice()) else {
                 return none;
             };
+            let (rss1, rss0, rss_e) = (fits.full, fits.sentences, fits.emotions);
             let effect = (rss0 - rss1).max(0.0) / (e - 1) as f64;
             let error = rss1 / df_error as f64;
             let f = if error > 0.0 {
@@ -156,6 +151,10 @@ pub fn emotion_subspace(effects: &[EmotionEffect]) -> Vec<usize> {
         .collect()
 }
 
+fn index_of<'a>(names: &[&'a str]) -> BTreeMap<&'a str, usize> {
+    names.iter().enumerate().map(|(i, n)| (*n, i)).collect()
+}
+
 fn dedup<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
     let mut out: Vec<&str> = Vec::new();
     for i in items {
@@ -164,13 +163,6 @@ fn dedup<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
         }
     }
     out
-}
-
-/// Residual sum of squares of the least-squares fit of `y` on the columns of `x`.
-fn rss(x: &DMatrix<f64>, y: &DVector<f64>) -> Option<f64> {
-    let xtx = x.transpose() * x;
-    let beta = xtx.cholesky()?.solve(&(x.transpose() * y));
-    Some((y - x * beta).norm_squared())
 }
 
 /// `P(F > f)` for an F distribution with `d1`, `d2` degrees of freedom:
@@ -270,6 +262,8 @@ fn ln_gamma(x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::DMatrix;
+
     use super::*;
 
     #[test]
@@ -289,6 +283,56 @@ mod tests {
         }
         assert_eq!(f_upper_tail(0.0, 2.0, 5.0), 1.0);
         assert!((ln_gamma(5.0) - 24f64.ln()).abs() < 1e-12);
+    }
+
+    /// Residual sum of squares of the least-squares fit of `y` on the columns of `x`.
+    fn dense_rss(x: &DMatrix<f64>, y: &DVector<f64>) -> f64 {
+        let xtx = x.transpose() * x;
+        let beta = xtx
+            .cholesky()
+            .expect("full rank")
+            .solve(&(x.transpose() * y));
+        (y - x * beta).norm_squared()
+    }
+
+    #[test]
+    fn block_fits_match_dense_dummy_designs_on_an_unbalanced_session() {
+        // 7 sentences x up to 3 emotions, some cells empty, some repeated.
+        let (mut sentence, mut emotion) = (Vec::new(), Vec::new());
+        for si in 0..7 {
+            for ei in 0..3 {
+                for _ in 0..(si + ei) % 3 {
+                    sentence.push(si);
+                    emotion.push(ei);
+                }
+            }
+            sentence.extend([si, si]);
+            emotion.extend([0, 1]);
+        }
+        let n = sentence.len();
+        let y: Vec<f64> = (0..n)
+            .map(|r| (r as f64 * 0.77).sin() + emotion[r] as f64 * 0.4 + sentence[r] as f64)
+            .collect();
+        let design = |sent: bool, emo: bool| {
+            let (cs, ce) = (if sent { 6 } else { 0 }, if emo { 2 } else { 0 });
+            DMatrix::from_fn(n, 1 + cs + ce, |r, c| match c {
+                0 => 1.0,
+                c if c <= cs => f64::from(u8::from(sentence[r] == c)),
+                c => f64::from(u8::from(emotion[r] == c - cs)),
+            })
+        };
+        let yv = DVector::from_column_slice(&y);
+        let fits = Blocks::new(sentence.clone(), emotion.clone(), 7, 3)
+            .fit(&y)
+            .expect("not confounded");
+        for (got, x) in [
+            (fits.full, design(true, true)),
+            (fits.sentences, design(true, false)),
+            (fits.emotions, design(false, true)),
+        ] {
+            let want = dense_rss(&x, &yv);
+            assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
+        }
     }
 
     #[test]

@@ -9,18 +9,29 @@
 //! - [`region_distance`]: `d_region,i = d(x_{E∪{i}}, x_all) − d(x_E, x_all)` on one region's
 //!   markers (Eq. 3–4), computed exactly from the region's Gram matrix `M_Rᵀ M_R`, so no marker
 //!   motion is reconstructed.
+//! - Each metric is also an accumulator fed one pair or one take at a time
+//!   ([`EmotionDistanceAcc`], [`LevelDistanceAcc`], [`ComponentMoments`]), so a session of hours
+//!   can be measured holding one sentence's takes; the whole-slice functions above are those
+//!   accumulators run over every input. [`ComponentMoments`] keeps the second moments of the
+//!   components, from which the region metric of any region and any emotion set follows, so
+//!   the emotion set need not be known while the takes stream past.
 //! - [`label`]: roles from the metrics, with the thresholds in [`LabelRules`].
 
+mod anova;
+mod distance;
 mod effect;
 
+pub use distance::{
+    emotion_distance, level_distance, region_distance, series_means, ComponentMoments,
+    EmotionDistanceAcc, LevelDistanceAcc,
+};
 pub use effect::{
     emotion_effects, emotion_subspace, f_upper_tail, EmotionEffect, TakeMeans, EMOTION_ALPHA,
 };
 
-use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use crate::dtw::{self, DtwError};
+use crate::dtw::DtwError;
 use crate::model::Role;
 
 /// Why the metrics could not be computed.
@@ -42,6 +53,14 @@ pub enum InterpretError {
         /// Markers in the model.
         markers: usize,
     },
+    /// Moments of some number of components asked about a model of another.
+    #[error("moments of {expected} components, model has {got}")]
+    ComponentCountMismatch {
+        /// Components in the moments.
+        expected: usize,
+        /// Components in the model.
+        got: usize,
+    },
     /// A region holds no marker.
     #[error("region has no markers")]
     EmptyRegion,
@@ -57,146 +76,6 @@ pub struct EmotionDistance {
     pub per_component: Vec<f64>,
     /// Aligned samples per pair (`q_i`).
     pub aligned_samples: Vec<usize>,
-}
-
-fn frames_of(series: &[f64], m: usize) -> Result<usize, InterpretError> {
-    if m == 0 || series.len() % m != 0 {
-        return Err(InterpretError::BadSeries {
-            len: series.len(),
-            m,
-        });
-    }
-    Ok(series.len() / m)
-}
-
-/// `d_emotion,j` over pairs of component series of the same sentence in two emotions.
-///
-/// `band` is the DTW Sakoe-Chiba radius in frames (`None`: unconstrained).
-///
-/// # Errors
-/// A series of the wrong shape, or an alignment failure (empty or non-finite series).
-pub fn emotion_distance(
-    pairs: &[(&[f64], &[f64])],
-    m: usize,
-    band: Option<usize>,
-) -> Result<EmotionDistance, InterpretError> {
-    let mut sum = vec![0.0; m];
-    let mut aligned_samples = Vec::with_capacity(pairs.len());
-    for (a, b) in pairs {
-        // Shapes checked first, for a typed error naming the series.
-        frames_of(a, m)?;
-        frames_of(b, m)?;
-        let alignment = dtw::align(&dtw::demeaned(a, m), &dtw::demeaned(b, m), m, band)?;
-        for &(i, j) in &alignment.path {
-            for (k, acc) in sum.iter_mut().enumerate() {
-                let d = a[i * m + k] - b[j * m + k];
-                *acc += d * d;
-            }
-        }
-        aligned_samples.push(alignment.path.len());
-    }
-    let total: usize = aligned_samples.iter().sum();
-    let per_component = sum
-        .iter()
-        .map(|s| (s / total.max(1) as f64).sqrt())
-        .collect();
-    Ok(EmotionDistance {
-        per_component,
-        aligned_samples,
-    })
-}
-
-/// `d_level,j`: the RMS over pairs of the difference of component `j`'s take means.
-///
-/// Emotion moves a component's level for a whole take, while speech, blinks and noise average
-/// out over a take of the same sentence. Unlike `d_emotion`, this does not grow with components
-/// that are noise (independent between takes, so their aligned RMS difference is about √2 for a
-/// unit-variance component), which makes its peak the robust label of emotion when the variance
-/// target keeps many components.
-///
-/// # Errors
-/// A series of the wrong shape.
-pub fn level_distance(pairs: &[(&[f64], &[f64])], m: usize) -> Result<Vec<f64>, InterpretError> {
-    let mut sum = vec![0.0; m];
-    for (a, b) in pairs {
-        let (na, nb) = (frames_of(a, m)?, frames_of(b, m)?);
-        for (k, acc) in sum.iter_mut().enumerate() {
-            let ma = a.iter().skip(k).step_by(m).sum::<f64>() / na.max(1) as f64;
-            let mb = b.iter().skip(k).step_by(m).sum::<f64>() / nb.max(1) as f64;
-            *acc += (ma - mb) * (ma - mb);
-        }
-    }
-    Ok(sum
-        .iter()
-        .map(|s| (s / pairs.len().max(1) as f64).sqrt())
-        .collect())
-}
-
-/// `d_region,i` for every component `i` (Eq. 4), given the emotion subset `emotion` (`E`, may be
-/// empty) and the region's marker indices.
-///
-/// The distance of Eq. 3 averages the squared 3-D marker distance over the region's `r` markers
-/// and all frames of all takes, then takes the square root.
-///
-/// # Errors
-/// Bad series shape, an empty region or a marker outside the model.
-pub fn region_distance(
-    mixing: &DMatrix<f64>,
-    takes: &[&[f64]],
-    region: &[usize],
-    emotion: &[usize],
-) -> Result<Vec<f64>, InterpretError> {
-    let m = mixing.ncols();
-    let markers = mixing.nrows() / 3;
-    if region.is_empty() {
-        return Err(InterpretError::EmptyRegion);
-    }
-    if let Some(&marker) = region.iter().find(|&&r| r >= markers) {
-        return Err(InterpretError::BadMarker { marker, markers });
-    }
-    // Gram matrix of the region's rows: ||M_R w||² = wᵀ G w.
-    let mut gram = DMatrix::<f64>::zeros(m, m);
-    for &r in region {
-        for row in r * 3..r * 3 + 3 {
-            let line = mixing.row(row);
-            gram += line.transpose() * line;
-        }
-    }
-    let mut base = 0.0; // Σ_t ||v_t||², v_t = M_R (u_t with E zeroed)
-    let mut cross = vec![0.0; m]; // Σ_t u_i(t) (G w_t)_i
-    let mut power = vec![0.0; m]; // Σ_t u_i(t)²
-    let mut q = 0usize;
-    let mut w = nalgebra::DVector::<f64>::zeros(m);
-    let mut gw = nalgebra::DVector::<f64>::zeros(m);
-    for series in takes {
-        frames_of(series, m)?;
-        for row in series.chunks_exact(m) {
-            w.copy_from_slice(row);
-            for &e in emotion {
-                w[e] = 0.0;
-            }
-            gw.gemv(1.0, &gram, &w, 0.0);
-            base += w.dot(&gw);
-            for i in 0..m {
-                if !emotion.contains(&i) {
-                    cross[i] += row[i] * gw[i];
-                    power[i] += row[i] * row[i];
-                }
-            }
-            q += 1;
-        }
-    }
-    let norm = (q.max(1) * region.len()) as f64;
-    let d_e = (base / norm).max(0.0).sqrt();
-    Ok((0..m)
-        .map(|i| {
-            if emotion.contains(&i) {
-                return 0.0;
-            }
-            let with_i = base - 2.0 * cross[i] + gram[(i, i)] * power[i];
-            (with_i / norm).max(0.0).sqrt() - d_e
-        })
-        .collect())
 }
 
 /// Thresholds of the labelling rule. Defaults are the documented values.

@@ -1,3 +1,5 @@
+use nalgebra::DMatrix;
+
 use super::*;
 
 /// Direct evaluation of Eq. 3–4 by reconstructing the region's markers.
@@ -101,4 +103,51 @@ fn labels_follow_the_largest_relative_region_influence() {
 #[test]
 fn no_clear_peak_means_no_emotion_component() {
     assert!(emotion_components(&[1.0, 1.1, 0.9, 1.2], &LabelRules::default()).is_empty());
+}
+
+#[test]
+fn accumulators_fed_one_input_at_a_time_match_the_whole_slice_metrics() {
+    let m = 3;
+    let take = |n: usize, phase: f64| -> Vec<f64> {
+        (0..n * m)
+            .map(|i| ((i as f64) * 0.37 + phase).sin() + (i % m) as f64 * 0.5)
+            .collect()
+    };
+    let (a, b, c) = (take(40, 0.0), take(48, 1.0), take(36, 2.0));
+    let pairs: [(&[f64], &[f64]); 2] = [(&a, &b), (&b, &c)];
+    let whole = emotion_distance(&pairs, m, Some(12)).expect("valid");
+    let mut acc = EmotionDistanceAcc::new(m, Some(12));
+    for (x, y) in pairs {
+        acc.add_pair(x, y).expect("valid");
+    }
+    assert_eq!(acc.finish(), whole);
+    let mut level = LevelDistanceAcc::new(m);
+    let means: Vec<Vec<f64>> = [&a, &b, &c]
+        .iter()
+        .map(|s| series_means(s, m).expect("valid"))
+        .collect();
+    level.add_means(&means[0], &means[1]).expect("valid");
+    level.add_means(&means[1], &means[2]).expect("valid");
+    assert_eq!(level.finish(), level_distance(&pairs, m).expect("valid"));
+    // Moments of the takes one by one give the direct metric over all of them, for any
+    // emotion set chosen afterwards.
+    let mixing = DMatrix::from_fn(4 * 3, m, |r, c| ((r * 5 + c * 7) % 9) as f64 - 4.0);
+    let mut moments = ComponentMoments::new(m);
+    for s in [&a, &b, &c] {
+        moments.add_series(s).expect("valid");
+    }
+    let all: Vec<f64> = [a, b, c].concat();
+    for e in [vec![], vec![1], vec![0, 2]] {
+        let got = moments
+            .region_distance(&mixing, &[0, 2], &e)
+            .expect("valid");
+        let want = region_brute(&mixing, &all, &[0, 2], &e);
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() < 1e-9, "{g} vs {w}");
+        }
+    }
+    assert!(matches!(
+        moments.region_distance(&DMatrix::zeros(12, 2), &[0], &[]),
+        Err(InterpretError::ComponentCountMismatch { .. })
+    ));
 }

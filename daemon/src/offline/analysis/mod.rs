@@ -8,17 +8,27 @@
 //! emotion gets a point in it (the mean over its takes, with the spread). Region metrics
 //! `d_region,i` on the mouth, eyebrows and eyelids label the speech, eyebrow and eyelid
 //! components (thresholds in [`ica_core::interpret::LabelRules`]).
+//!
+//! [`analyze_session`] reads the session sentence by sentence and keeps only per-take and
+//! per-pair summaries between sentences ([`SessionStats`]), so memory does not grow with the
+//! session (issue 18); [`analyze`] is the same accumulator over takes already in memory.
 
 mod html;
 mod map;
 pub mod space;
+mod stats;
+mod stream;
 mod svg;
+
+pub use stats::{SessionStats, TakeSeries};
+pub use stream::analyze_session;
+pub use svg::{timeline_takes, TimelineTake};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use ica_core::interpret::{self, LabelRules};
+use ica_core::interpret::LabelRules;
 use ica_core::model::{IcaModel, Role};
 use replay::session::{Regions, Session};
 use serde::Serialize;
@@ -185,19 +195,9 @@ pub fn resolve_regions(path: &Path, model: &IcaModel) -> Result<BTreeMap<String,
     Ok(resolved)
 }
 
-fn pairs_of(takes: &[SessionTake]) -> Vec<(usize, usize)> {
-    let mut pairs = Vec::new();
-    for (i, a) in takes.iter().enumerate() {
-        for (j, b) in takes.iter().enumerate().skip(i + 1) {
-            if a.sentence == b.sentence && a.emotion != b.emotion {
-                pairs.push((i, j));
-            }
-        }
-    }
-    pairs
-}
-
-/// Runs the analysis on projected takes.
+/// Runs the analysis on projected takes held together (the whole session in memory): the
+/// reference the streamed [`analyze_session`] must match, and the path for callers that
+/// already hold the takes.
 ///
 /// # Errors
 /// A metric that cannot be computed (bad shapes, non-finite components).
@@ -206,140 +206,37 @@ pub fn analyze(
     takes: &[SessionTake],
     regions: &BTreeMap<String, Vec<usize>>,
 ) -> Result<Report> {
-    let model = inputs.model;
-    let m = model.components();
-    let rules = LabelRules::default();
+    let m = inputs.model.components();
     let series: Vec<Vec<f64>> = takes.iter().map(|t| t.projected.as_f64()).collect();
-    let pairs = pairs_of(takes);
-    let (d_emotion, d_level, pair_summaries) = if pairs.is_empty() {
-        (None, None, Vec::new())
-    } else {
-        let refs: Vec<(&[f64], &[f64])> = pairs
-            .iter()
-            .map(|&(i, j)| (series[i].as_slice(), series[j].as_slice()))
-            .collect();
-        let longest = series.iter().map(|s| s.len() / m).max().unwrap_or(0);
-        let band = ((longest as f64) * DTW_BAND_SHARE).ceil() as usize;
-        let d = interpret::emotion_distance(&refs, m, Some(band))?;
-        let level = interpret::level_distance(&refs, m)?;
-        let summaries = pairs
-            .iter()
-            .zip(&d.aligned_samples)
-            .map(|(&(i, j), &q)| PairSummary {
-                sentence: takes[i].sentence.clone(),
-                a: (takes[i].file.clone(), takes[i].emotion.clone()),
-                b: (takes[j].file.clone(), takes[j].emotion.clone()),
-                aligned_samples: q,
-            })
-            .collect();
-        (Some(d.per_component), Some(level), summaries)
-    };
-    let space = (!pairs.is_empty()).then(|| {
-        let levels: Vec<space::TakeLevel> = takes
-            .iter()
-            .zip(&series)
-            .map(|(t, s)| space::TakeLevel {
-                sentence: t.sentence.clone(),
-                emotion: t.emotion.clone(),
-                means: take_means(s, m),
-            })
-            .collect();
-        space::emotion_space(&levels, m)
-    });
-    // Region metrics and roles treat the emotion axes as the emotion set; components that only
-    // shift a little with emotion keep their region role.
-    let emotion = space.as_ref().map(|s| s.axes.clone()).unwrap_or_default();
-    let all: Vec<&[f64]> = series.iter().map(Vec::as_slice).collect();
-    let mut d_region = BTreeMap::new();
-    for (name, markers) in regions {
-        let d = interpret::region_distance(model.mixing(), &all, markers, &emotion)?;
-        d_region.insert(name.clone(), d);
-    }
-    let role_inputs: Vec<(Role, &[f64])> = ROLE_REGIONS
+    let longest = series.iter().map(|s| s.len() / m).max().unwrap_or(0);
+    let group: Vec<TakeSeries<'_>> = takes
         .iter()
-        .filter_map(|(name, role)| d_region.get(*name).map(|d| (*role, d.as_slice())))
-        .collect();
-    let roles = interpret::label(m, &emotion, &role_inputs, &rules);
-    let levels: BTreeMap<String, f64> = match &space {
-        Some(sp) => match sp.components.iter().position(|&k| Some(k) == sp.main) {
-            Some(at) => sp
-                .points
-                .iter()
-                .map(|(n, p)| (n.clone(), p.level[at]))
-                .collect(),
-            None => BTreeMap::new(),
-        },
-        None => BTreeMap::new(),
-    };
-    let emotion_note = match (&d_emotion, emotion.is_empty()) {
-        (None, _) => "emotion not measured: the manifest has no pair of takes with the same \
-                      sentence in two different emotions"
-            .to_string(),
-        (Some(_), true) => format!(
-            "no component's take levels differ between emotions (F test at p < {} over {m} components): no component is labelled emotion",
-            interpret::EMOTION_ALPHA
-        ),
-        (Some(_), false) => String::new(),
-    };
-    let components = (0..m)
-        .map(|k| ComponentReport {
-            index: k,
-            role: roles[k],
-            d_emotion: d_emotion.as_ref().map(|d| d[k]),
-            d_level: d_level.as_ref().map(|d| d[k]),
-            d_region: d_region.iter().map(|(n, d)| (n.clone(), d[k])).collect(),
-            mixing_norm_mm: model.mixing().column(k).norm(),
-            emotion_effect: space.as_ref().map(|s| s.effects[k]),
+        .zip(&series)
+        .enumerate()
+        .map(|(index, (t, s))| TakeSeries {
+            index,
+            file: &t.file,
+            sentence: &t.sentence,
+            emotion: &t.emotion,
+            series: s,
         })
         .collect();
-    Ok(Report {
-        model: inputs.model_path.display().to_string(),
-        manifest: inputs.manifest_path.display().to_string(),
-        components,
-        emotion_components: emotion,
-        emotion_measured: d_emotion.is_some(),
-        emotion_note,
-        levels,
-        space,
-        pairs: pair_summaries,
-        takes: takes
-            .iter()
-            .zip(&series)
-            .map(|(t, s)| TakeSummary {
-                file: t.file.clone(),
-                sentence: t.sentence.clone(),
-                emotion: t.emotion.clone(),
-                frames: s.len() / m,
-                component_means: (0..m)
-                    .map(|k| interpret::component_mean(&[s], m, k).unwrap_or(0.0))
-                    .collect(),
-            })
-            .collect(),
-        thresholds: rules,
-        dtw_band_share: DTW_BAND_SHARE,
-        regions: regions
-            .iter()
-            .map(|(n, idx)| {
-                (
-                    n.clone(),
-                    idx.iter().map(|&i| model.labels()[i].clone()).collect(),
-                )
-            })
-            .collect(),
-        quality: model.quality().clone(),
-    })
+    let mut stats = SessionStats::new(m, longest);
+    stats.add_group(&group)?;
+    stats.finish(inputs, regions)
 }
 
-/// The mean of each component over a take (frames x m series).
-fn take_means(series: &[f64], m: usize) -> Vec<f64> {
-    let frames = (series.len() / m.max(1)).max(1) as f64;
-    let mut means = vec![0.0; m];
-    for row in series.chunks_exact(m) {
-        for (acc, v) in means.iter_mut().zip(row) {
-            *acc += v / frames;
-        }
-    }
-    means
+/// The takes the timeline chart draws ([`timeline_takes`]), from takes held in memory.
+pub fn timeline_of(report: &Report, takes: &[SessionTake]) -> Vec<TimelineTake> {
+    timeline_takes(report)
+        .into_iter()
+        .filter_map(|i| takes.get(i))
+        .map(|t| TimelineTake {
+            sentence: t.sentence.clone(),
+            emotion: t.emotion.clone(),
+            u: t.projected.u.clone(),
+        })
+        .collect()
 }
 
 /// Stores roles and the emotion space (components, main component, points) in the model.
@@ -366,11 +263,16 @@ pub fn write_into_model(model: &mut IcaModel, report: &Report) -> Result<()> {
     Ok(())
 }
 
-/// Writes `report.json`, `components.svg`, `timeline.svg` and `report.html` into `dir`.
+/// Writes `report.json`, `components.svg`, `timeline.svg` (of `timeline`, the takes
+/// [`timeline_takes`] picks) and `report.html` into `dir`.
 ///
 /// # Errors
 /// Any file that cannot be written.
-pub fn write_report(dir: &Path, report: &Report, takes: &[SessionTake]) -> Result<Vec<PathBuf>> {
+pub fn write_report(
+    dir: &Path,
+    report: &Report,
+    timeline: &[TimelineTake],
+) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let write = |name: &str, text: String| -> Result<PathBuf> {
         let path = dir.join(name);
@@ -379,7 +281,7 @@ pub fn write_report(dir: &Path, report: &Report, takes: &[SessionTake]) -> Resul
     };
     let json = serde_json::to_string_pretty(report).context("report serialisation")?;
     let components = svg::components_chart(report);
-    let timeline = svg::timeline_chart(report, takes);
+    let timeline = svg::timeline_chart(report, timeline);
     let mut written = Vec::new();
     if let Some(map) = map::emotion_map(report) {
         written.push(write("emotion_map.svg", map)?);

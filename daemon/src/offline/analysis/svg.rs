@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use ica_core::model::Role;
 
-use super::{Report, SessionTake};
+use super::Report;
 
 const BAR_W: f64 = 360.0;
 const BAR_H: f64 = 220.0;
@@ -119,8 +119,22 @@ pub fn components_chart(report: &Report) -> String {
     svg
 }
 
-/// Up to five sentences, each shown in the two emotions whose levels differ most, alternating.
-fn timeline_takes<'a>(report: &Report, takes: &'a [SessionTake]) -> Vec<&'a SessionTake> {
+/// One take the timeline draws: its sentence, emotion and components (frames x m).
+#[derive(Debug, Clone)]
+pub struct TimelineTake {
+    /// Sentence id.
+    pub sentence: String,
+    /// Emotion name.
+    pub emotion: String,
+    /// Components, frames x m, as projected.
+    pub u: Vec<f32>,
+}
+
+/// The takes the timeline draws, as indices into `report.takes` (manifest order): up to five
+/// sentences, each in the two emotions whose levels differ most, alternating. It needs only
+/// the report, so a streamed analysis reads just these takes again for the chart.
+pub fn timeline_takes(report: &Report) -> Vec<usize> {
+    let takes = &report.takes;
     let mut names: Vec<(&String, &f64)> = report.levels.iter().collect();
     names.sort_by(|a, b| a.1.total_cmp(b.1));
     let pick: Vec<&str> = match (names.first(), names.last()) {
@@ -134,12 +148,13 @@ fn timeline_takes<'a>(report: &Report, takes: &'a [SessionTake]) -> Vec<&'a Sess
         if out.len() >= 10 {
             break;
         }
+        let of_sentence = || (0..takes.len()).filter(|&i| takes[i].sentence == s);
         if pick.is_empty() {
-            out.extend(takes.iter().filter(|t| t.sentence == s).take(2));
+            out.extend(of_sentence().take(2));
             continue;
         }
         for e in &pick {
-            out.extend(takes.iter().find(|t| t.sentence == s && t.emotion == *e));
+            out.extend(of_sentence().find(|&i| takes[i].emotion == *e));
         }
     }
     out
@@ -147,10 +162,9 @@ fn timeline_takes<'a>(report: &Report, takes: &'a [SessionTake]) -> Vec<&'a Sess
 
 /// Figure 2: every component's series over alternating-emotion takes, one row per component,
 /// with the takes shaded by emotion.
-pub fn timeline_chart(report: &Report, takes: &[SessionTake]) -> String {
-    let shown = timeline_takes(report, takes);
+pub fn timeline_chart(report: &Report, shown: &[TimelineTake]) -> String {
     let m = report.components.len();
-    let total: usize = shown.iter().map(|t| t.projected.u.len() / m.max(1)).sum();
+    let total: usize = shown.iter().map(|t| t.u.len() / m.max(1)).sum();
     let (w, row_h, left) = (1000.0, 70.0, 60.0);
     let h = row_h * m as f64 + 40.0;
     let mut svg = format!(
@@ -160,8 +174,8 @@ pub fn timeline_chart(report: &Report, takes: &[SessionTake]) -> String {
     let mut x = left;
     let shades = ["#f0f0f0", "#c8c8c8"];
     let mut emotions: Vec<&str> = Vec::new();
-    for t in &shown {
-        let frames = t.projected.u.len() / m.max(1);
+    for t in shown {
+        let frames = t.u.len() / m.max(1);
         if !emotions.contains(&t.emotion.as_str()) {
             emotions.push(&t.emotion);
         }
@@ -182,7 +196,7 @@ pub fn timeline_chart(report: &Report, takes: &[SessionTake]) -> String {
         let y0 = 20.0 + row_h * k as f64;
         let values: Vec<f32> = shown
             .iter()
-            .flat_map(|t| t.projected.u.chunks_exact(m).map(move |row| row[k]))
+            .flat_map(|t| t.u.chunks_exact(m).map(move |row| row[k]))
             .collect();
         let max = values.iter().fold(1e-6f32, |a, v| a.max(v.abs()));
         let mut path = String::new();

@@ -61,7 +61,7 @@ pub(crate) trait FrameSink {
 }
 
 /// Matches a source's labels to a model's.
-fn label_map(model: &IcaModel, source: &Source) -> Result<LabelMap> {
+pub(crate) fn label_map(model: &IcaModel, source: &Source) -> Result<LabelMap> {
     LabelMap::new(model.labels(), source.labels())
         .with_context(|| format!("{}", source.path().display()))
 }

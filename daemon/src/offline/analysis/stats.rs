@@ -1,0 +1,251 @@
+//! The analysis as an accumulator: groups of projected takes go in (a sentence's takes, or the
+//! whole session at once), the [`Report`] comes out. Between groups it keeps only O(m) numbers
+//! per take and per pair plus the m x m moments of [`ComponentMoments`], so a session of hours
+//! is measured holding one sentence's takes (issue 18).
+//!
+//! Pairs are formed within a group, so every take of a sentence must be in the same group.
+//! The numbers do not depend on how the session is grouped, except for the order of the
+//! floating-point sums when the groups do not follow the manifest's order; takes and pairs are
+//! reported in manifest order either way.
+
+use std::collections::BTreeMap;
+
+use anyhow::Result;
+use ica_core::interpret::{
+    self, ComponentMoments, EmotionDistanceAcc, LabelRules, LevelDistanceAcc,
+};
+use ica_core::model::Role;
+
+use super::space::{self, EmotionSpace, TakeLevel};
+use super::{ComponentReport, Inputs, PairSummary, Report, TakeSummary};
+use super::{DTW_BAND_SHARE, ROLE_REGIONS};
+
+/// One projected take handed to [`SessionStats::add_group`].
+#[derive(Debug, Clone, Copy)]
+pub struct TakeSeries<'a> {
+    /// Position in the manifest: orders the report's takes and pairs.
+    pub index: usize,
+    /// File, as the manifest names it.
+    pub file: &'a str,
+    /// Sentence id.
+    pub sentence: &'a str,
+    /// Emotion name.
+    pub emotion: &'a str,
+    /// Components over the take, frames x m.
+    pub series: &'a [f64],
+}
+
+/// What is kept of a take once its series is dropped.
+#[derive(Debug)]
+struct TakeRecord {
+    index: usize,
+    summary: TakeSummary,
+    /// The means the emotion space tests ([`take_means`]).
+    level: Vec<f64>,
+}
+
+/// The analysis of a session so far; see the module docs.
+#[derive(Debug)]
+pub struct SessionStats {
+    m: usize,
+    emotion: EmotionDistanceAcc,
+    level: LevelDistanceAcc,
+    moments: ComponentMoments,
+    takes: Vec<TakeRecord>,
+    /// Manifest indices of each pair, with its summary.
+    pairs: Vec<((usize, usize), PairSummary)>,
+}
+
+impl SessionStats {
+    /// Nothing seen yet, `m` components; `longest` is the frame count of the session's longest
+    /// take, which sets the DTW band of every pair ([`DTW_BAND_SHARE`]), so it must be known
+    /// before the first pair.
+    pub fn new(m: usize, longest: usize) -> Self {
+        let band = ((longest as f64) * DTW_BAND_SHARE).ceil() as usize;
+        Self {
+            m,
+            emotion: EmotionDistanceAcc::new(m, Some(band)),
+            level: LevelDistanceAcc::new(m),
+            moments: ComponentMoments::new(m),
+            takes: Vec::new(),
+            pairs: Vec::new(),
+        }
+    }
+
+    /// Adds a group of takes, in manifest order, and every pair within it (same sentence,
+    /// different emotions).
+    ///
+    /// # Errors
+    /// A metric that cannot be computed (bad shapes, non-finite components).
+    pub fn add_group(&mut self, takes: &[TakeSeries<'_>]) -> Result<()> {
+        let m = self.m;
+        let mut means = Vec::with_capacity(takes.len());
+        for t in takes {
+            self.moments.add_series(t.series)?;
+            let component_means = interpret::series_means(t.series, m)?;
+            means.push(component_means.clone());
+            self.takes.push(TakeRecord {
+                index: t.index,
+                summary: TakeSummary {
+                    file: t.file.to_string(),
+                    sentence: t.sentence.to_string(),
+                    emotion: t.emotion.to_string(),
+                    frames: t.series.len() / m,
+                    component_means,
+                },
+                level: take_means(t.series, m),
+            });
+        }
+        for (i, a) in takes.iter().enumerate() {
+            for (j, b) in takes.iter().enumerate().skip(i + 1) {
+                if a.sentence != b.sentence || a.emotion == b.emotion {
+                    continue;
+                }
+                let aligned_samples = self.emotion.add_pair(a.series, b.series)?;
+                self.level.add_means(&means[i], &means[j])?;
+                let summary = PairSummary {
+                    sentence: a.sentence.to_string(),
+                    a: (a.file.to_string(), a.emotion.to_string()),
+                    b: (b.file.to_string(), b.emotion.to_string()),
+                    aligned_samples,
+                };
+                self.pairs.push(((a.index, b.index), summary));
+            }
+        }
+        Ok(())
+    }
+
+    /// The report over every group added.
+    ///
+    /// # Errors
+    /// A region metric that cannot be computed (a region outside the model).
+    pub fn finish(
+        mut self,
+        inputs: &Inputs<'_>,
+        regions: &BTreeMap<String, Vec<usize>>,
+    ) -> Result<Report> {
+        let m = self.m;
+        let model = inputs.model;
+        self.takes.sort_by_key(|t| t.index);
+        self.pairs.sort_by_key(|p| p.0);
+        let measured = !self.pairs.is_empty();
+        let d_emotion = measured.then(|| self.emotion.finish().per_component);
+        let d_level = measured.then(|| self.level.finish());
+        let space = measured.then(|| space_of(&self.takes, m));
+        // Region metrics and roles treat the emotion axes as the emotion set; components that
+        // only shift a little with emotion keep their region role.
+        let emotion = space.as_ref().map(|s| s.axes.clone()).unwrap_or_default();
+        let d_region: BTreeMap<String, Vec<f64>> = regions
+            .iter()
+            .map(|(name, markers)| {
+                let d = self
+                    .moments
+                    .region_distance(model.mixing(), markers, &emotion)?;
+                Ok((name.clone(), d))
+            })
+            .collect::<Result<_>>()?;
+        let rules = LabelRules::default();
+        let roles = roles(m, &emotion, &d_region, &rules);
+        let components = (0..m)
+            .map(|k| ComponentReport {
+                index: k,
+                role: roles[k],
+                d_emotion: d_emotion.as_ref().map(|d| d[k]),
+                d_level: d_level.as_ref().map(|d| d[k]),
+                d_region: d_region.iter().map(|(n, d)| (n.clone(), d[k])).collect(),
+                mixing_norm_mm: model.mixing().column(k).norm(),
+                emotion_effect: space.as_ref().map(|s| s.effects[k]),
+            })
+            .collect();
+        Ok(Report {
+            model: inputs.model_path.display().to_string(),
+            manifest: inputs.manifest_path.display().to_string(),
+            components,
+            emotion_note: emotion_note(measured, emotion.is_empty(), m),
+            emotion_components: emotion,
+            emotion_measured: measured,
+            levels: levels_of(space.as_ref()),
+            space,
+            pairs: self.pairs.into_iter().map(|(_, p)| p).collect(),
+            takes: self.takes.into_iter().map(|t| t.summary).collect(),
+            thresholds: rules,
+            dtw_band_share: DTW_BAND_SHARE,
+            regions: regions
+                .iter()
+                .map(|(n, idx)| {
+                    let labels = idx.iter().map(|&i| model.labels()[i].clone()).collect();
+                    (n.clone(), labels)
+                })
+                .collect(),
+            quality: model.quality().clone(),
+        })
+    }
+}
+
+/// The emotion space of the takes' levels.
+fn space_of(takes: &[TakeRecord], m: usize) -> EmotionSpace {
+    let levels: Vec<TakeLevel> = takes
+        .iter()
+        .map(|t| TakeLevel {
+            sentence: t.summary.sentence.clone(),
+            emotion: t.summary.emotion.clone(),
+            means: t.level.clone(),
+        })
+        .collect();
+    space::emotion_space(&levels, m)
+}
+
+/// Roles from the region metrics, given the emotion set.
+fn roles(
+    m: usize,
+    emotion: &[usize],
+    d_region: &BTreeMap<String, Vec<f64>>,
+    rules: &LabelRules,
+) -> Vec<Role> {
+    let role_inputs: Vec<(Role, &[f64])> = ROLE_REGIONS
+        .iter()
+        .filter_map(|(name, role)| d_region.get(*name).map(|d| (*role, d.as_slice())))
+        .collect();
+    interpret::label(m, emotion, &role_inputs, rules)
+}
+
+/// Level of the main emotion component per emotion name (empty without one).
+fn levels_of(space: Option<&EmotionSpace>) -> BTreeMap<String, f64> {
+    let Some(sp) = space else {
+        return BTreeMap::new();
+    };
+    match sp.components.iter().position(|&k| Some(k) == sp.main) {
+        Some(at) => sp
+            .points
+            .iter()
+            .map(|(n, p)| (n.clone(), p.level[at]))
+            .collect(),
+        None => BTreeMap::new(),
+    }
+}
+
+/// Why emotion was not measured or has no component (empty when it has).
+fn emotion_note(measured: bool, no_component: bool, m: usize) -> String {
+    match (measured, no_component) {
+        (false, _) => "emotion not measured: the manifest has no pair of takes with the same \
+                       sentence in two different emotions"
+            .to_string(),
+        (true, true) => format!(
+            "no component's take levels differ between emotions (F test at p < {} over {m} components): no component is labelled emotion",
+            interpret::EMOTION_ALPHA
+        ),
+        (true, false) => String::new(),
+    }
+}
+
+/// The mean of each component over a take (frames x m series), as the emotion space tests it.
+fn take_means(series: &[f64], m: usize) -> Vec<f64> {
+    let frames = (series.len() / m.max(1)).max(1) as f64;
+    let mut means = vec![0.0; m];
+    for row in series.chunks_exact(m) {
+        for (acc, v) in means.iter_mut().zip(row) {
+            *acc += v / frames;
+        }
+    }
+    means
+}

@@ -1,0 +1,167 @@
+//! `analyze` over a session of any length in bounded memory (issue 18): the takes are read
+//! sentence by sentence, each through the same block reader and [`FrameProcessor`] path as
+//! `project`, and a sentence's series are dropped once its pairs, means and moments are in
+//! [`SessionStats`]. Three reads, each for a reason:
+//!
+//! 1. Headers first: the DTW band of every pair is a share of the session's longest take, so
+//!    every take's length is needed before the first pair (C3D and TRC declare it; a CSV is
+//!    counted). This also refuses a missing or empty take before hours of work.
+//! 2. Every take once, sentence by sentence. The region metrics need the emotion set, known
+//!    only at the end, so the moments they need for any set are kept instead of a second pass.
+//! 3. The few takes the timeline chart draws (at most ten), again: which ones depends on the
+//!    emotion levels, also known only at the end.
+//!
+//! [`FrameProcessor`]: crate::engine::frame::FrameProcessor
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use ica_core::model::IcaModel;
+use replay::session::Session;
+
+use super::stats::{SessionStats, TakeSeries};
+use super::svg::{timeline_takes, TimelineTake};
+use super::{Inputs, Report};
+use crate::offline::progress::{Progress, Silent};
+use crate::offline::streamed::{self, Frame, FrameSink, Source, BLOCK_FRAMES};
+use crate::offline::takes::input_limit;
+
+/// Analyses the session at `session` on `inputs.model`, reporting progress in takes; returns
+/// the report and the takes its timeline draws (for [`super::write_report`]).
+///
+/// # Errors
+/// A take that cannot be read or shares no marker with the model, or a metric that cannot be
+/// computed.
+pub fn analyze_session(
+    inputs: &Inputs<'_>,
+    session: &Session,
+    regions: &BTreeMap<String, Vec<usize>>,
+    progress: &mut dyn Progress,
+) -> Result<(Report, Vec<TimelineTake>)> {
+    let model = inputs.model;
+    let frames = take_frames(session, progress)?;
+    let longest = frames.iter().copied().max().unwrap_or(0);
+    let mut stats = SessionStats::new(model.components(), longest);
+    progress.step("analysing", "takes", Some(session.takes.len() as u64));
+    for group in sentence_groups(session) {
+        let series: Vec<Vec<f64>> = group
+            .iter()
+            .map(|&i| {
+                let u = project(model, &session.path_of(&session.takes[i]), frames[i])?;
+                check_length(session, i, u.len() / model.components(), frames[i])?;
+                progress.advance(1);
+                Ok(u.into_iter().map(f64::from).collect())
+            })
+            .collect::<Result<_>>()?;
+        let takes: Vec<TakeSeries<'_>> = group
+            .iter()
+            .zip(&series)
+            .map(|(&index, s)| {
+                let entry = &session.takes[index];
+                TakeSeries {
+                    index,
+                    file: &entry.file,
+                    sentence: &entry.sentence,
+                    emotion: &entry.emotion,
+                    series: s,
+                }
+            })
+            .collect();
+        stats.add_group(&takes)?;
+    }
+    let report = stats.finish(inputs, regions)?;
+    let shown = timeline_takes(&report);
+    progress.step("timeline", "takes", Some(shown.len() as u64));
+    let mut timeline = Vec::with_capacity(shown.len());
+    for i in shown {
+        let entry = &session.takes[i];
+        timeline.push(TimelineTake {
+            sentence: entry.sentence.clone(),
+            emotion: entry.emotion.clone(),
+            u: project(model, &session.path_of(entry), frames[i])?,
+        });
+        progress.advance(1);
+    }
+    Ok((report, timeline))
+}
+
+/// Each take's frame count, from its header when it declares one, else by reading it.
+fn take_frames(session: &Session, progress: &mut dyn Progress) -> Result<Vec<usize>> {
+    progress.step("reading headers", "takes", Some(session.takes.len() as u64));
+    let mut frames = Vec::with_capacity(session.takes.len());
+    for entry in &session.takes {
+        let path = session.path_of(entry);
+        let mut source = Source::open(&path, input_limit())?;
+        let n = match source.frames() {
+            Some(n) => n,
+            None => {
+                let (mut block, mut n) = (source.empty_take(), 0);
+                while source.read_block(BLOCK_FRAMES, &mut block)? > 0 {
+                    n += block.n_frames();
+                }
+                n
+            }
+        };
+        if n == 0 {
+            bail!("{}: take has no frames", path.display());
+        }
+        frames.push(n);
+        progress.advance(1);
+    }
+    Ok(frames)
+}
+
+/// The manifest's take indices grouped by sentence, groups in order of first appearance,
+/// takes in manifest order within a group: all the takes a sentence's pairs need.
+fn sentence_groups(session: &Session) -> Vec<Vec<usize>> {
+    let mut at: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, entry) in session.takes.iter().enumerate() {
+        let g = *at.entry(&entry.sentence).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(i);
+    }
+    groups
+}
+
+/// A take read while it was being analysed must be as long as its header said: the band of
+/// every pair came from the headers.
+fn check_length(session: &Session, i: usize, got: usize, expected: usize) -> Result<()> {
+    if got != expected {
+        let path = session.path_of(&session.takes[i]);
+        bail!(
+            "{}: {got} frames read, {expected} when the session was scanned (file changed?)",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Collects the components of every frame.
+struct Components(Vec<f32>);
+
+impl FrameSink for Components {
+    fn frame(&mut self, frame: Frame<'_>) -> Result<()> {
+        self.0.extend_from_slice(frame.u);
+        Ok(())
+    }
+}
+
+/// The components of one take of `frames` frames (frames x m), read in blocks.
+fn project(model: &IcaModel, path: &Path, frames: usize) -> Result<Vec<f32>> {
+    let mut source = Source::open(path, input_limit())?;
+    let map = streamed::label_map(model, &source)?;
+    let mut sink = Components(Vec::with_capacity(frames * model.components()));
+    let progress = (&mut Silent as &mut dyn Progress, "");
+    streamed::run_pass(
+        model,
+        (&mut source, &map),
+        BLOCK_FRAMES,
+        progress,
+        &mut sink,
+    )?;
+    Ok(sink.0)
+}
