@@ -189,3 +189,32 @@ fn issue_18_analyze_shows_progress_in_a_pipe() {
         ],
     );
 }
+
+#[test]
+fn a_take_whose_header_lies_about_its_length_is_an_error_not_an_abort() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (manifest, model) = session(dir.path(), 2);
+    let trc = dir.path().join("take1.trc");
+    let text = std::fs::read_to_string(&trc).expect("trc");
+    let mut lines: Vec<String> = text.split('\n').map(String::from).collect();
+    let mut values: Vec<&str> = lines[2].split('\t').collect();
+    values[2] = "99999999999999"; // NumFrames
+    lines[2] = values.join("\t");
+    std::fs::write(&trc, lines.join("\n")).expect("write trc");
+    let report = dir.path().join("report");
+    let out = common::run(&[
+        "analyze",
+        "--model",
+        p(&model),
+        "--manifest",
+        p(&manifest),
+        "--out",
+        p(&report),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("take1.trc: header declares 99999999999999 frames"),
+        "{err}"
+    );
+}

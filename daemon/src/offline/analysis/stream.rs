@@ -154,7 +154,10 @@ impl FrameSink for Components {
 fn project(model: &IcaModel, path: &Path, frames: usize) -> Result<Vec<f32>> {
     let mut source = Source::open(path, input_limit())?;
     let map = streamed::label_map(model, &source)?;
-    let mut sink = Components(Vec::with_capacity(frames * model.components()));
+    // `frames` comes from the header, which may lie: reserve at most one block up front and
+    // let the read show the true length (checked against the header afterwards).
+    let reserve = frames.min(BLOCK_FRAMES) * model.components();
+    let mut sink = Components(Vec::with_capacity(reserve));
     let progress = (&mut Silent as &mut dyn Progress, "");
     streamed::run_pass(
         model,
