@@ -40,34 +40,20 @@ impl TrainingFrames<'_> {
     }
 }
 
-/// Working vectors of [`residual_into`].
-struct Residual {
-    centred: DVector<f64>,
-    u: DVector<f64>,
-    r: DVector<f64>,
-}
+/// Frames whose residuals are computed at once: two matrix products per block instead of two
+/// matrix-vector products per frame.
+const RESIDUAL_BLOCK: usize = 512;
 
-impl Residual {
-    fn new(model: &IcaModel) -> Self {
-        let c = model.channels();
-        Self {
-            centred: DVector::zeros(c),
-            u: DVector::zeros(model.components()),
-            r: DVector::zeros(c),
+/// The residuals `(x − mean) − M W (x − mean)` of the frames in the columns of `x` (complete
+/// frames, or means of complete frames: the residual is linear in `x`), in place.
+fn residual_columns(model: &IcaModel, x: &mut DMatrix<f64>) {
+    for mut column in x.column_iter_mut() {
+        for (v, mu) in column.iter_mut().zip(model.mean()) {
+            *v -= mu;
         }
     }
-
-    /// The residual `(x − mean) − M W (x − mean)` of `x` (a complete frame, or a mean of
-    /// complete frames: the residual is linear in `x`), into `self.r`.
-    fn of(&mut self, model: &IcaModel, x: impl Iterator<Item = f64>) -> &DVector<f64> {
-        for ((v, x), mu) in self.centred.iter_mut().zip(x).zip(model.mean()) {
-            *v = x - mu;
-        }
-        self.u.gemv(1.0, model.unmixing(), &self.centred, 0.0);
-        self.r.copy_from(&self.centred);
-        self.r.gemv(-1.0, model.mixing(), &self.u, 1.0);
-        &self.r
-    }
+    let u = model.unmixing() * &*x;
+    x.gemm(-1.0, model.mixing(), &u, 1.0);
 }
 
 /// Frames examined at most by [`residual_by_marker`] (evenly strided).
@@ -95,15 +81,30 @@ pub fn residual_by_marker_of<'a>(
     model: &IcaModel,
     frames: impl Iterator<Item = &'a [f32]>,
 ) -> Vec<f64> {
-    let mut res = Residual::new(model);
+    let c = model.channels();
     let mut sq = vec![0.0; model.markers()];
     let mut count = 0usize;
-    for x in frames {
-        let r = res.of(model, x.iter().map(|&v| f64::from(v)));
-        for (k, s) in sq.iter_mut().enumerate() {
-            *s += r[3 * k].powi(2) + r[3 * k + 1].powi(2) + r[3 * k + 2].powi(2);
+    let mut block: Vec<f64> = Vec::with_capacity(RESIDUAL_BLOCK * c);
+    let mut add = |block: &mut Vec<f64>| {
+        let mut r = DMatrix::from_vec(c, block.len() / c, std::mem::take(block));
+        residual_columns(model, &mut r);
+        for frame in r.column_iter() {
+            for (k, s) in sq.iter_mut().enumerate() {
+                *s += frame[3 * k].powi(2) + frame[3 * k + 1].powi(2) + frame[3 * k + 2].powi(2);
+            }
         }
-        count += 1;
+        count += r.ncols();
+        *block = r.data.into();
+        block.clear();
+    };
+    for x in frames {
+        block.extend(x.iter().map(|&v| f64::from(v)));
+        if block.len() == RESIDUAL_BLOCK * c {
+            add(&mut block);
+        }
+    }
+    if !block.is_empty() {
+        add(&mut block);
     }
     sq.iter()
         .map(|s| (s / count.max(1) as f64).sqrt())
@@ -130,11 +131,10 @@ pub fn slow_block_stride(frames: usize, block: usize) -> usize {
 pub fn slow_residual(model: &IcaModel, data: &TrainingFrames<'_>) -> Option<(f64, usize)> {
     let c = data.channels;
     let block = slow_block_frames(data.rate_hz);
-    let mut res = Residual::new(model);
-    let mut blocks: Vec<DVector<f64>> = Vec::new();
+    let mut means: Vec<Vec<f64>> = Vec::new();
     let stride_blocks = slow_block_stride(data.frames(), block);
     for take in data.takes {
-        let mut acc = DVector::zeros(c);
+        let mut acc = vec![0.0; c];
         let mut filled = 0usize;
         let mut index = 0usize;
         for f in take.clone() {
@@ -143,11 +143,13 @@ pub fn slow_residual(model: &IcaModel, data: &TrainingFrames<'_>) -> Option<(f64
                 filled = 0;
                 continue;
             }
-            acc += res.of(model, data.frame(f).iter().map(|&v| f64::from(v)));
+            acc.iter_mut()
+                .zip(data.frame(f))
+                .for_each(|(a, &v)| *a += f64::from(v));
             filled += 1;
             if filled == block {
                 if index % stride_blocks == 0 {
-                    blocks.push(&acc / block as f64);
+                    means.push(acc.iter().map(|a| a / block as f64).collect());
                 }
                 index += 1;
                 acc.fill(0.0);
@@ -155,29 +157,36 @@ pub fn slow_residual(model: &IcaModel, data: &TrainingFrames<'_>) -> Option<(f64
             }
         }
     }
-    slow_direction(blocks, c)
+    slow_residual_of_means(model, &means)
 }
 
 /// [`slow_residual`] from the kept blocks' mean frames (the residual is linear, so the
 /// residual of a block's mean is the block's mean residual), as a streaming caller collects
 /// them.
 pub fn slow_residual_of_means(model: &IcaModel, means: &[Vec<f64>]) -> Option<(f64, usize)> {
-    let mut res = Residual::new(model);
-    let blocks = means
-        .iter()
-        .map(|x| res.of(model, x.iter().copied()).clone())
-        .collect();
-    slow_direction(blocks, model.channels())
-}
-
-/// The leading direction of the block residuals at its peak marker.
-fn slow_direction(blocks: Vec<DVector<f64>>, c: usize) -> Option<(f64, usize)> {
-    if blocks.len() < 8 {
+    let c = model.channels();
+    if means.len() < 8 {
         return None;
     }
-    let mean = blocks.iter().fold(DVector::zeros(c), |a, b| a + b) / blocks.len() as f64;
-    let b = DMatrix::from_fn(blocks.len(), c, |i, j| blocks[i][j] - mean[j]);
-    let (lambda, v) = leading_direction(&b);
+    let mut r = DMatrix::from_iterator(c, means.len(), means.iter().flatten().copied());
+    residual_columns(model, &mut r);
+    slow_direction(&r)
+}
+
+/// The leading direction of the block residuals (the columns of `blocks`) at its peak marker.
+fn slow_direction(blocks: &DMatrix<f64>) -> Option<(f64, usize)> {
+    let (c, rows) = blocks.shape();
+    if rows < 8 {
+        return None;
+    }
+    let mean = blocks.column_mean();
+    let mut centred = blocks.clone();
+    for mut column in centred.column_iter_mut() {
+        column -= &mean;
+    }
+    // The blocks' second moments (channels x channels), then power iteration on them.
+    let gram = &centred * centred.transpose() / rows as f64;
+    let (lambda, v) = leading_direction(&gram);
     let (marker, peak) = (0..c / 3)
         .map(|k| {
             (
@@ -189,17 +198,15 @@ fn slow_direction(blocks: Vec<DVector<f64>>, c: usize) -> Option<(f64, usize)> {
     Some((lambda.sqrt() * peak, marker))
 }
 
-/// Largest eigenvalue of `bᵀb / rows` and its unit eigenvector, by power iteration.
-fn leading_direction(b: &DMatrix<f64>) -> (f64, DVector<f64>) {
-    let c = b.ncols();
+/// Largest eigenvalue of the symmetric `gram` and its unit eigenvector, by power iteration.
+fn leading_direction(gram: &DMatrix<f64>) -> (f64, DVector<f64>) {
+    let c = gram.ncols();
     let mut v = DVector::from_fn(c, |i, _| 1.0 + (i % 7) as f64 * 0.1);
     v.normalize_mut();
     let mut lambda = 0.0;
-    let mut t = DVector::zeros(b.nrows());
     let mut w = DVector::zeros(c);
     for _ in 0..200 {
-        t.gemv(1.0, b, &v, 0.0);
-        w.gemv_tr(1.0 / b.nrows() as f64, b, &t, 0.0);
+        w.gemv(1.0, gram, &v, 0.0);
         let next = w.norm();
         if next <= 0.0 {
             return (0.0, v);
@@ -267,4 +274,106 @@ pub fn noise_of_differences(per_channel: &mut [Vec<f64>]) -> f64 {
         .map(|d2| mad(d2) / 6f64.sqrt())
         .collect();
     median(&mut spread)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::tests::{labels, report};
+
+    /// A little LCG: the test's numbers without a dependency.
+    fn numbers(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
+    /// 5 markers, 3 components, a random mixing and mean.
+    fn model() -> IcaModel {
+        let mut r = numbers(7);
+        let mixing = DMatrix::from_fn(15, 3, |_, _| r());
+        let mean = (0..15).map(|_| 100.0 * r()).collect();
+        IcaModel::new(labels(5), 120.0, mean, mixing, report(15, 3)).expect("valid parts")
+    }
+
+    /// `(x − mean) − M W (x − mean)` of one frame, by matrix-vector products.
+    fn residual_of(model: &IcaModel, x: &[f64]) -> DVector<f64> {
+        let centred =
+            DVector::from_iterator(x.len(), x.iter().zip(model.mean()).map(|(x, m)| x - m));
+        let u = model.unmixing() * &centred;
+        centred - model.mixing() * u
+    }
+
+    #[test]
+    fn residuals_in_blocks_are_the_residuals_of_each_frame() {
+        let model = model();
+        let mut r = numbers(11);
+        // More than two blocks, the last one partial.
+        let frames: Vec<Vec<f32>> = (0..2 * RESIDUAL_BLOCK + 37)
+            .map(|_| (0..15).map(|_| (100.0 * r()) as f32).collect())
+            .collect();
+        let mut sq = [0.0; 5];
+        for x in &frames {
+            let x: Vec<f64> = x.iter().map(|&v| f64::from(v)).collect();
+            let res = residual_of(&model, &x);
+            for (k, s) in sq.iter_mut().enumerate() {
+                *s += (0..3).map(|a| res[3 * k + a].powi(2)).sum::<f64>();
+            }
+        }
+        let got = residual_by_marker_of(&model, frames.iter().map(Vec::as_slice));
+        for (k, s) in sq.iter().enumerate() {
+            let want = (s / frames.len() as f64).sqrt();
+            assert!(want > 1.0, "the residual is not trivial");
+            assert!(
+                (got[k] - want).abs() <= 1e-9 * want,
+                "marker {k}: {} vs {want}",
+                got[k]
+            );
+        }
+    }
+
+    #[test]
+    fn the_slow_residual_is_the_leading_direction_of_the_block_residuals() {
+        let model = model();
+        let mut r = numbers(3);
+        // Block means along one slow direction plus a little noise.
+        let slow: Vec<f64> = (0..15)
+            .map(|i| if i / 3 == 2 { 1.0 } else { 0.1 })
+            .collect();
+        let means: Vec<Vec<f64>> = (0..40)
+            .map(|_| {
+                let a = 10.0 * r();
+                slow.iter()
+                    .zip(model.mean())
+                    .map(|(s, m)| m + a * s + 0.01 * r())
+                    .collect()
+            })
+            .collect();
+        // Reference: the residuals' covariance and its largest eigenpair.
+        let res: Vec<DVector<f64>> = means.iter().map(|x| residual_of(&model, x)).collect();
+        let mean = res.iter().fold(DVector::zeros(15), |a, b| a + b) / res.len() as f64;
+        let mut cov = DMatrix::zeros(15, 15);
+        for x in &res {
+            let d = x - &mean;
+            cov += &d * d.transpose();
+        }
+        cov /= res.len() as f64;
+        let eig = cov.symmetric_eigen();
+        let top = eig.eigenvalues.imax();
+        let v = eig.eigenvectors.column(top);
+        let (marker, peak) = (0..5)
+            .map(|k| (k, (0..3).map(|a| v[3 * k + a].powi(2)).sum::<f64>().sqrt()))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("markers");
+        let want = eig.eigenvalues[top].sqrt() * peak;
+        let (got, at) = slow_residual_of_means(&model, &means).expect("enough blocks");
+        assert_eq!(at, marker);
+        assert!(want > 0.1, "the slow residual is not trivial: {want}");
+        assert!((got - want).abs() <= 1e-6 * want, "{got} vs {want}");
+        assert!(slow_residual_of_means(&model, &means[..7]).is_none());
+    }
 }

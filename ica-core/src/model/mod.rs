@@ -372,4 +372,4 @@ impl IcaModel {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -1,7 +1,7 @@
 use super::*;
 use crate::report::TrainReport;
 
-fn report(channels: usize, components: usize) -> TrainReport {
+pub(crate) fn report(channels: usize, components: usize) -> TrainReport {
     TrainReport {
         frames_total: 10,
         frames_used: 10,
@@ -20,7 +20,7 @@ fn report(channels: usize, components: usize) -> TrainReport {
     }
 }
 
-fn labels(markers: usize) -> Vec<String> {
+pub(crate) fn labels(markers: usize) -> Vec<String> {
     (0..markers).map(|i| format!("M{i}")).collect()
 }
 
