@@ -129,6 +129,15 @@ struct Step {
     last_line: Instant,
 }
 
+/// A step's time: to the hundredth of a second under ten seconds, where steps differ.
+fn seconds(secs: f64) -> String {
+    if secs < 10.0 {
+        format!("{secs:.2}")
+    } else {
+        format!("{secs:.1}")
+    }
+}
+
 impl<W: Write> Lines<W> {
     /// Lines for `command` into `out`, one every `interval` while a step runs.
     pub fn new(command: &'static str, out: W, interval: Duration) -> Self {
@@ -161,20 +170,22 @@ impl<W: Write> Lines<W> {
             // A step that counts nothing (restarts in memory): its time is what there is.
             let _ = writeln!(
                 self.out,
-                "{}: {} done in {secs:.1} s{}",
+                "{}: {} done in {} s{}",
                 self.command,
                 s.name,
+                seconds(secs),
                 note(&self.note)
             );
             return;
         }
         let _ = writeln!(
             self.out,
-            "{}: {} done: {} {} in {secs:.1} s ({} {}/s){}",
+            "{}: {} done: {} {} in {} s ({} {}/s){}",
             self.command,
             s.name,
             HumanCount(s.done),
             s.unit,
+            seconds(secs),
             HumanCount(rate as u64),
             s.unit,
             note(&self.note)
@@ -224,7 +235,7 @@ fn note(text: &str) -> String {
     }
 }
 
-impl<W: Write> Progress for Lines<W> {
+impl<W: Write + Send> Progress for Lines<W> {
     fn step(&mut self, name: &str, unit: &'static str, total: Option<u64>) {
         self.end_step();
         self.note.clear();

@@ -3,7 +3,7 @@
 //! every few seconds in a pipe: [`crate::commands::progress`]); the library never prints.
 
 /// Where long offline work reports how far it got.
-pub trait Progress {
+pub trait Progress: Send {
     /// A new step begins (the previous one ended): `total` units to go, if known.
     fn step(&mut self, name: &str, unit: &'static str, total: Option<u64>);
     /// `n` more units of the current step are done.

@@ -172,37 +172,52 @@ fn negentropy(
 
 /// The seeded restarts on `z`, each from its own random start; keeps the best (see [`run`]).
 pub(crate) fn explore(z: &DMatrix<f64>, s: Settings) -> IcaRun {
+    use rayon::prelude::*;
     let (m, frames) = z.shape();
-    let mut ws = symmetric::Workspace::new(m, frames);
-    let mut best: Option<(usize, f64, DMatrix<f64>, DMatrix<f64>)> = None;
+    // Each restart on its own workspace, at once on the caller's rayon pool; the choice below
+    // reads them in run order, so the result does not depend on the thread count.
+    let runs: Vec<(Outcome, f64, DMatrix<f64>)> = (0..s.restarts)
+        .into_par_iter()
+        .map(|k| {
+            let mut ws = symmetric::Workspace::new(m, frames);
+            let out = solve(z, random_start(m, restart_seed(s.seed, k)), s, &mut ws);
+            let negentropy = negentropy(&out.w, z, s.contrast, &mut ws.gy);
+            (out, negentropy, ws.gy)
+        })
+        .collect();
+    let mut best: Option<(usize, f64)> = None;
     let mut reports = Vec::with_capacity(s.restarts);
-    let mut restart_w = Vec::with_capacity(s.restarts);
-    for k in 0..s.restarts {
-        let seed = restart_seed(s.seed, k);
-        let out = solve(z, random_start(m, seed), s, &mut ws);
-        let negentropy = negentropy(&out.w, z, s.contrast, &mut ws.gy);
+    for (k, (out, negentropy, _)) in runs.iter().enumerate() {
         reports.push(RestartReport {
-            seed,
+            seed: restart_seed(s.seed, k),
             iterations: out.iterations,
             converged: out.converged,
             last_delta: out.last_delta,
-            negentropy,
+            negentropy: *negentropy,
             frames,
             refinement: None,
         });
-        let better = match &best {
+        let better = match best {
             None => true,
-            Some((b, score, _, _)) => {
-                let (b_conv, conv) = (reports[*b].converged, out.converged);
-                (conv && !b_conv) || (conv == b_conv && negentropy > *score)
+            Some((b, score)) => {
+                let (b_conv, conv) = (reports[b].converged, out.converged);
+                (conv && !b_conv) || (conv == b_conv && *negentropy > score)
             }
         };
-        restart_w.push(out.w.clone());
         if better {
-            best = Some((k, negentropy, out.w, ws.gy.clone()));
+            best = Some((k, *negentropy));
         }
     }
-    let (best, _, w, sources) = best.expect("restarts >= 1 is checked before fitting");
+    let (best, _) = best.expect("restarts >= 1 is checked before fitting");
+    let mut restart_w = Vec::with_capacity(s.restarts);
+    let mut kept = None;
+    for (k, (out, _, sources)) in runs.into_iter().enumerate() {
+        if k == best {
+            kept = Some((out.w.clone(), sources));
+        }
+        restart_w.push(out.w);
+    }
+    let (w, sources) = kept.expect("the best restart is one of them");
     IcaRun {
         w,
         sources,

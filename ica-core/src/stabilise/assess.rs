@@ -15,6 +15,7 @@
 //!   (high).
 
 use nalgebra::{Matrix3, SMatrix, SVector, SymmetricEigen, Vector3};
+use rayon::prelude::*;
 
 use super::sample::Sample;
 use super::{centre, kabsch, point, Pose};
@@ -84,7 +85,9 @@ pub(crate) fn assess_group(
         .copied()
         .filter(|m| !group.contains(m))
         .collect();
+    // Frames at once on the current rayon pool (in order: the result is the same).
     let fits: Vec<(usize, Fitted)> = (0..sample.frames())
+        .into_par_iter()
         .filter_map(|s| Some((3 * s + 1, fit(sample, group, &template, 3 * s + 1)?)))
         .collect();
     if fits.is_empty() {

@@ -13,6 +13,7 @@
 //! fewer the last pose is held and the frame is flagged.
 
 use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod assess;
@@ -190,13 +191,22 @@ impl Stabiliser {
         for _ in 0..3 {
             let mut sum = vec![Vector3::<f64>::zeros(); markers.len()];
             let mut count = vec![0usize; markers.len()];
-            for f in 0..n_frames {
+            // Every frame's pose at once on the current rayon pool, then summed in frame
+            // order, so the template does not depend on the thread count.
+            let poses: Vec<Option<Pose>> = (0..n_frames)
+                .into_par_iter()
+                .map(|f| {
+                    let frame = frame_of(f);
+                    let pairs = (0..markers.len())
+                        .filter(|&k| !missing[f * n_markers + markers[k]])
+                        .map(|k| (&template[k], point(frame, markers[k])));
+                    kabsch(pairs).map(|(pose, _)| pose)
+                })
+                .collect();
+            for (f, pose) in poses.iter().enumerate() {
                 let frame = frame_of(f);
                 let present = |k: &usize| !missing[f * n_markers + markers[*k]];
-                let pairs = (0..markers.len())
-                    .filter(present)
-                    .map(|k| (&template[k], point(frame, markers[k])));
-                let Some((pose, _)) = kabsch(pairs) else {
+                let Some(pose) = pose else {
                     continue;
                 };
                 let inv = pose.rotation.transpose();

@@ -120,24 +120,31 @@ impl Sample {
 
     /// Median over `markers` and axes of the robust spread of second differences / √6.
     pub(crate) fn noise_mm(&self, markers: &[usize]) -> f64 {
-        let mut per_axis = Vec::new();
-        let mut d2 = Vec::new();
-        for &m in markers {
-            for axis in 0..3 {
-                d2.clear();
-                for s in 0..self.frames() {
-                    let [b, a, n] = self.triple(s);
-                    if let (Some(p), Some(q), Some(r)) =
-                        (self.get(b, m), self.get(a, m), self.get(n, m))
-                    {
-                        d2.push(f64::from(p[axis]) - 2.0 * f64::from(q[axis]) + f64::from(r[axis]));
-                    }
-                }
-                if d2.len() >= 10 {
-                    per_axis.push(mad(&mut d2) / 6f64.sqrt());
-                }
-            }
-        }
+        use rayon::prelude::*;
+        // Markers at once on the current rayon pool, collected in order.
+        let mut per_axis: Vec<f64> = markers
+            .par_iter()
+            .flat_map_iter(|&m| {
+                let mut d2 = Vec::new();
+                (0..3)
+                    .filter_map(|axis| {
+                        d2.clear();
+                        for s in 0..self.frames() {
+                            let [b, a, n] = self.triple(s);
+                            if let (Some(p), Some(q), Some(r)) =
+                                (self.get(b, m), self.get(a, m), self.get(n, m))
+                            {
+                                d2.push(
+                                    f64::from(p[axis]) - 2.0 * f64::from(q[axis])
+                                        + f64::from(r[axis]),
+                                );
+                            }
+                        }
+                        (d2.len() >= 10).then(|| mad(&mut d2) / 6f64.sqrt())
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
         median(&mut per_axis)
     }
 }

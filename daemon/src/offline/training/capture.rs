@@ -73,14 +73,21 @@ pub(super) fn learn(
     };
     // 2. Speeds and plausible regions measured in head coordinates.
     let (head_xyz, head_missing, _, _) = run_prep(frames, n, rate_hz, &capture)?;
-    capture.max_speed_mm_s = match options.speed {
-        SpeedLimit::Off => None,
-        SpeedLimit::MmPerS(v) => Some(v),
-        SpeedLimit::Auto => auto_speed(&head_xyz, &head_missing, frames, n, rate_hz),
-    };
-    if options.bounds {
-        capture.bounds = Some(marker_bounds(&head_xyz, &head_missing, n));
-    }
+    // The two are independent: at once on the current rayon pool.
+    let (speed, bounds) = rayon::join(
+        || match options.speed {
+            SpeedLimit::Off => None,
+            SpeedLimit::MmPerS(v) => Some(v),
+            SpeedLimit::Auto => auto_speed(&head_xyz, &head_missing, frames, n, rate_hz),
+        },
+        || {
+            options
+                .bounds
+                .then(|| marker_bounds(&head_xyz, &head_missing, n))
+        },
+    );
+    capture.max_speed_mm_s = speed;
+    capture.bounds = bounds;
     Ok(Learned {
         capture,
         reference,

@@ -21,29 +21,31 @@ pub const MIN_BOUNDS_MM: f64 = 15.0;
 /// percentile distance from it, at least [`MIN_BOUNDS_MM`]. Medians and percentiles ignore the
 /// rare glitches they are meant to catch.
 pub(super) fn marker_bounds(xyz: &[f32], missing: &[bool], n: usize) -> MarkerBounds {
+    use rayon::prelude::*;
     let frames = missing.len() / n.max(1);
-    let mut centre = Vec::with_capacity(n);
-    let mut radius_mm = Vec::with_capacity(n);
-    let mut values = Vec::with_capacity(frames);
-    for m in 0..n {
-        let present: Vec<usize> = (0..frames).filter(|&f| !missing[f * n + m]).collect();
-        let mut c = [0.0f64; 3];
-        for (a, slot) in c.iter_mut().enumerate() {
+    // Markers at once on the current rayon pool; each marker's numbers are its own.
+    let (centre, radius_mm) = (0..n)
+        .into_par_iter()
+        .map(|m| {
+            let present: Vec<usize> = (0..frames).filter(|&f| !missing[f * n + m]).collect();
+            let mut values = Vec::with_capacity(present.len());
+            let mut c = [0.0f64; 3];
+            for (a, slot) in c.iter_mut().enumerate() {
+                values.clear();
+                values.extend(present.iter().map(|&f| f64::from(xyz[(f * n + m) * 3 + a])));
+                *slot = quantile(&mut values, 0.5);
+            }
             values.clear();
-            values.extend(present.iter().map(|&f| f64::from(xyz[(f * n + m) * 3 + a])));
-            *slot = quantile(&mut values, 0.5);
-        }
-        values.clear();
-        values.extend(present.iter().map(|&f| {
-            (0..3)
-                .map(|a| (f64::from(xyz[(f * n + m) * 3 + a]) - c[a]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        }));
-        let r = quantile(&mut values, 0.99) * BOUNDS_FACTOR;
-        centre.push(c);
-        radius_mm.push(r.max(MIN_BOUNDS_MM));
-    }
+            values.extend(present.iter().map(|&f| {
+                (0..3)
+                    .map(|a| (f64::from(xyz[(f * n + m) * 3 + a]) - c[a]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            }));
+            let r = quantile(&mut values, 0.99) * BOUNDS_FACTOR;
+            (c, r.max(MIN_BOUNDS_MM))
+        })
+        .unzip();
     MarkerBounds { centre, radius_mm }
 }
 

@@ -210,31 +210,47 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
 pub(crate) type PrepRun = (Vec<f32>, Vec<bool>, usize, Vec<f64>);
 
 /// Runs every take through a fresh [`FramePrep`]: positions, per-marker mask, glitches,
-/// residuals.
+/// residuals. Takes run at once on the current rayon pool, each into its own part of the
+/// output, so the result does not depend on the thread count.
 pub(crate) fn run_prep(
     frames: &[ModelFrames],
     n: usize,
     rate_hz: f64,
     capture: &CaptureSettings,
 ) -> Result<PrepRun> {
+    use rayon::prelude::*;
     let total: usize = frames.iter().map(ModelFrames::frames).sum();
-    let mut xyz = Vec::with_capacity(total * n * 3);
-    let mut missing = Vec::with_capacity(total * n);
-    let mut glitches = 0;
-    let mut residuals = Vec::new();
+    let mut xyz = vec![0.0; total * n * 3];
+    let mut missing = vec![false; total * n];
+    let (mut xyz_rest, mut missing_rest) = (xyz.as_mut_slice(), missing.as_mut_slice());
+    let mut parts = Vec::with_capacity(frames.len());
     for take in frames {
-        let mut prep = FramePrep::new(n, rate_hz, capture);
-        for f in 0..take.frames() {
-            let (p, m) = take.frame(f);
-            let out = prep.prepare(p, m)?;
-            xyz.extend_from_slice(out.xyz);
-            missing.extend_from_slice(out.missing);
-            glitches += out.info.glitches;
-            if out.info.pose.is_some() && !out.info.pose_held {
-                residuals.push(out.info.residual_mm);
-            }
-        }
+        let (x, rest) = std::mem::take(&mut xyz_rest).split_at_mut(take.frames() * n * 3);
+        let (m, rest_m) = std::mem::take(&mut missing_rest).split_at_mut(take.frames() * n);
+        (xyz_rest, missing_rest) = (rest, rest_m);
+        parts.push((take, x, m));
     }
+    let done = parts
+        .into_par_iter()
+        .map(|(take, x, m)| {
+            let mut prep = FramePrep::new(n, rate_hz, capture);
+            let (mut glitches, mut residuals) = (0, Vec::new());
+            let frames = x.chunks_exact_mut(n * 3).zip(m.chunks_exact_mut(n));
+            for (f, (x, m)) in frames.enumerate() {
+                let (p, raw) = take.frame(f);
+                let out = prep.prepare(p, raw)?;
+                x.copy_from_slice(out.xyz);
+                m.copy_from_slice(out.missing);
+                glitches += out.info.glitches;
+                if out.info.pose.is_some() && !out.info.pose_held {
+                    residuals.push(out.info.residual_mm);
+                }
+            }
+            Ok((glitches, residuals))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let glitches = done.iter().map(|(g, _)| g).sum();
+    let residuals = done.into_iter().flat_map(|(_, r)| r).collect();
     Ok((xyz, missing, glitches, residuals))
 }
 
