@@ -91,7 +91,8 @@ pub fn train_files(
                 None,
             ),
         };
-        return super::train(takes, options, &mut stage);
+        // On the pool, so the restarts keep to --threads.
+        return pool.install(|| super::train(takes, options, &mut stage));
     }
     streamed(scanned, options, &pool, progress)
 }
@@ -103,12 +104,14 @@ fn streamed(
     progress: &mut dyn Progress,
 ) -> Result<Trained> {
     progress.step("learning the head and glitch limits", "frames", None);
-    let learned = capture::learn(
-        &scanned.sample,
-        &scanned.labels,
-        scanned.rate_hz,
-        &options.prep,
-    )?;
+    let learned = pool.install(|| {
+        capture::learn(
+            &scanned.sample,
+            &scanned.labels,
+            scanned.rate_hz,
+            &options.prep,
+        )
+    })?;
     let total = scanned.total_frames();
     let (scanned, raw) = scanned.take_raw()?;
     let (mut collected, head_residuals) = statistics(&scanned, raw, &learned, pool, progress)?;
@@ -208,21 +211,44 @@ fn statistics(
         .map(|r| frames[r.clone()].iter().sum())
         .collect();
     let record = 13 * scanned.first_markers;
+    // Each batch is prepared on the pool while the previous one is collected here, so the
+    // pool does not wait for the collecting (which writes the prepared spill).
+    let mut pending: Option<(usize, Vec<read::PreparedTake>)> = None;
+    let mut collect = |pending: Option<(usize, Vec<read::PreparedTake>)>,
+                       collected: &mut Collected,
+                       refs: &mut Option<RefResiduals<'_>>|
+     -> Result<()> {
+        if let Some((b, batch)) = pending {
+            collected.add_batch(&batch, refs.as_mut(), pool)?;
+            progress.advance(groups[b] as u64);
+        }
+        Ok(())
+    };
     raw.for_each_group(&groups, &mut |b, bytes| {
         let mut starts = vec![0];
         for &f in &frames[batches[b].clone()] {
             starts.push(starts.last().copied().unwrap_or(0) + f * record);
         }
-        let batch = pool.install(|| {
-            starts
-                .par_windows(2)
-                .map(|w| prep.prepare(&bytes[w[0]..w[1]]))
-                .collect::<Result<Vec<_>>>()
-        })?;
-        collected.add_batch(&batch, refs.as_mut(), pool)?;
-        progress.advance(groups[b] as u64);
+        let prepare = || {
+            pool.install(|| {
+                starts
+                    .par_windows(2)
+                    .map(|w| prep.prepare(&bytes[w[0]..w[1]]))
+                    .collect::<Result<Vec<_>>>()
+            })
+        };
+        let previous = pending.take();
+        let (batch, done) = std::thread::scope(|s| {
+            let batch = s.spawn(prepare);
+            let done = collect(previous, &mut collected, &mut refs);
+            (batch.join(), done)
+        });
+        done?;
+        let batch = batch.map_err(|_| anyhow::anyhow!("a take preparation panicked"))??;
+        pending = Some((b, batch));
         Ok(())
     })?;
+    collect(pending, &mut collected, &mut refs)?;
     let residuals = refs.map(|r| r.by_label(&scanned.labels));
     Ok((collected, residuals))
 }

@@ -34,7 +34,8 @@ pub(super) fn batches(sizes: &[u64], target: u64) -> Vec<Range<usize>> {
 }
 
 /// Loads every item of each batch on the pool with `load`, then calls `each` with the batch's
-/// results in order; stops at the first error.
+/// results in order; stops at the first error. The next batch loads while `each` works on
+/// the current one, so memory holds two batches and the pool does not wait for `each`.
 ///
 /// # Errors
 /// The first error of `load` or `each`.
@@ -44,15 +45,30 @@ pub(super) fn for_each_batch<T: Send>(
     load: &(dyn Fn(usize) -> Result<T> + Sync),
     each: &mut dyn FnMut(Range<usize>, Vec<T>) -> Result<()>,
 ) -> Result<()> {
-    for range in batches {
-        let loaded: Vec<T> = pool.install(|| {
+    let load_batch = |range: &Range<usize>| {
+        pool.install(|| {
             range
                 .clone()
                 .into_par_iter()
                 .map(load)
                 .collect::<Result<Vec<T>>>()
-        })?;
-        each(range.clone(), loaded)?;
+        })
+    };
+    let Some(first) = batches.first() else {
+        return Ok(());
+    };
+    let mut loaded = load_batch(first)?;
+    for (k, range) in batches.iter().enumerate() {
+        let current = std::mem::take(&mut loaded);
+        let (next, done) = std::thread::scope(|s| {
+            let next = batches.get(k + 1).map(|r| s.spawn(|| load_batch(r)));
+            let done = each(range.clone(), current);
+            (next.map(std::thread::ScopedJoinHandle::join), done)
+        });
+        done?;
+        if let Some(next) = next {
+            loaded = next.map_err(|_| anyhow::anyhow!("a take loader panicked"))??;
+        }
     }
     Ok(())
 }

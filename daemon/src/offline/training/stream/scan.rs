@@ -20,7 +20,7 @@ use crate::offline::training::{MissingCounts, PrepOptions};
 use crate::offline::{load_take, LoadedTake, ModelFrames};
 
 /// Bytes of take files loaded at once in the first pass.
-const SCAN_BATCH_BYTES: u64 = 64 << 20;
+const SCAN_BATCH_BYTES: u64 = 16 << 20;
 
 /// What the first pass found.
 #[derive(Debug)]
