@@ -183,16 +183,19 @@ export function createControl(send) {
         : `${snap.amount.toFixed(2)} → ${snap.amountGoal.toFixed(2)}`);
       setText($("st-ramp"), `${snap.ramp.toFixed(2)} s`);
       setText($("st-bypass"), snap.bypass ? "on" : "off");
-      $("st-bypass").style.color = snap.bypass ? "var(--warn)" : "";
-      $("bypass").setAttribute("aria-pressed", snap.bypass ? "true" : "false");
+      // Only changes are written (ten times a second): each write invalidates the layout.
+      $("st-bypass").classList.toggle("warn", snap.bypass);
+      const pressed = snap.bypass ? "true" : "false";
+      if ($("bypass").getAttribute("aria-pressed") !== pressed) $("bypass").setAttribute("aria-pressed", pressed);
       for (const b of document.querySelectorAll(".emo-btn")) {
         b.classList.toggle("active", b.dataset.emotion === snap.target);
       }
       if (performance.now() > draggingUntil && document.activeElement !== amount) {
-        amount.value = String(snap.amountGoal);
-        amountOut.textContent = snap.amountGoal.toFixed(2);
+        if (amount.value !== String(snap.amountGoal)) amount.value = String(snap.amountGoal);
+        setText(amountOut, snap.amountGoal.toFixed(2));
       }
-      if (document.activeElement !== $("ramp")) $("ramp").value = snap.ramp.toFixed(2);
+      const ramp = $("ramp");
+      if (document.activeElement !== ramp && ramp.value !== snap.ramp.toFixed(2)) ramp.value = snap.ramp.toFixed(2);
       drawMap(s);
     },
     onReply(msg) {

@@ -211,7 +211,8 @@ export function createFace(els, redraw) {
         s.frame.n = s.snap.n;
       }
       for (const v of views) drawView(v, s);
-      els.title.textContent = s.name;
+      // Only a change is written: any text written invalidates the page's layout.
+      if (els.title.textContent !== s.name) els.title.textContent = s.name;
       // Text relayouts the page: four times a second is enough to read it.
       const now = performance.now();
       if (now - textAt >= 250) {

@@ -4,29 +4,54 @@
 const $ = (id) => document.getElementById(id);
 const fmt = (v) => (v === null || v === undefined ? "—" : Number(v).toLocaleString("en-US"));
 
+// The panel is refreshed twice a second; only what changed is written, so a steady daemon
+// costs the browser no layout.
+const setText = (el, text) => { if (el.textContent !== text) el.textContent = text; };
+const setClass = (el, cls) => { if (el.className !== cls) el.className = cls; };
+
+/** `count` children of `box`, made by `make` when missing, extra ones removed. */
+function children(box, count, make) {
+  while (box.children.length > count) box.lastElementChild.remove();
+  while (box.children.length < count) box.append(make());
+  return [...box.children];
+}
+
 function cells(row, values) {
-  row.replaceChildren(...values.map(([v, cls]) => {
-    const td = document.createElement("td");
-    td.textContent = v;
-    if (cls) td.className = cls;
-    return td;
-  }));
+  children(row, values.length, () => document.createElement("td")).forEach((td, i) => {
+    const [v, cls] = values[i];
+    setText(td, v);
+    setClass(td, cls || "");
+  });
   return row;
 }
 
+/** Rows of a table body, one per item of `rows` ([cells, attributes]). */
+function rows(body, list) {
+  children(body, list.length, () => document.createElement("tr")).forEach((tr, i) => {
+    const [values, attrs = {}] = list[i];
+    cells(tr, values);
+    for (const [k, v] of Object.entries(attrs)) {
+      if (k === "className") setClass(tr, v);
+      else if (tr.getAttribute(k) !== v) tr.setAttribute(k, v);
+    }
+  });
+}
+
 function kv(box, pairs) {
-  box.replaceChildren(...pairs.map(([k, v, hot]) => {
+  children(box, pairs.length, () => {
     const d = document.createElement("div");
     const a = document.createElement("span");
     a.className = "dim";
-    a.textContent = k;
-    const b = document.createElement("span");
-    b.textContent = v;
-    if (hot) b.className = "hot";
-    d.dataset.key = k;
-    d.append(a, b);
+    d.append(a, document.createElement("span"));
     return d;
-  }));
+  }).forEach((d, i) => {
+    const [k, v, hot] = pairs[i];
+    const [a, b] = d.children;
+    setText(a, k);
+    setText(b, v);
+    setClass(b, hot ? "hot" : "");
+    if (d.dataset.key !== k) d.dataset.key = k;
+  });
 }
 
 function defaultPath() {
@@ -63,37 +88,34 @@ export function createHealth(sendControl) {
       ["rate", m ? `${m.rate_hz} Hz` : "—"],
     ]);
     const warnings = (m && m.warnings) || [];
-    $("warnings").replaceChildren(...warnings.map((w) => {
-      const li = document.createElement("li");
-      li.textContent = w;
-      return li;
-    }));
+    children($("warnings"), warnings.length, () => document.createElement("li"))
+      .forEach((li, i) => setText(li, warnings[i]));
   }
 
   return {
     setModel,
     update(msg, selected) {
       status = msg;
-      $("h-in").textContent = fmt(msg.frames_in);
-      $("h-out").textContent = fmt(msg.frames_out);
-      $("h-subs").textContent = fmt(msg.subscribers.length);
+      setText($("h-in"), fmt(msg.frames_in));
+      setText($("h-out"), fmt(msg.frames_out));
+      setText($("h-subs"), fmt(msg.subscribers.length));
       const sel = selected && msg.streams.find((st) => st.id === selected.id);
       const drops = sel ? sel.duplicates + sel.stale : 0;
       const el = $("stream-drops");
-      el.textContent = sel ? fmt(drops) : "—";
-      el.dataset.value = String(drops);
+      setText(el, sel ? fmt(drops) : "—");
+      if (el.dataset.value !== String(drops)) el.dataset.value = String(drops);
       el.classList.toggle("bad", drops > 0);
-      const body = $("t-streams").tBodies[0];
-      body.replaceChildren(...msg.streams.map((st) => {
-        const tr = cells(document.createElement("tr"), [
+      rows($("t-streams").tBodies[0], msg.streams.map((st) => [
+        [
           [st.name], [fmt(st.frames + st.duplicates + st.stale), "n"], [fmt(st.frames), "n"],
           [fmt(st.duplicates), "n"], [fmt(st.stale), "n"], [`${st.matched_markers}/${st.model_markers}`, "n"],
-        ]);
-        tr.dataset.stream = st.id;
-        tr.title = `source ${st.source}${st.performer ? ` · performer ${st.performer}` : ""}`;
-        if (sel && st.id === sel.id) tr.className = "sel";
-        return tr;
-      }));
+        ],
+        {
+          "data-stream": String(st.id),
+          title: `source ${st.source}${st.performer ? ` · performer ${st.performer}` : ""}`,
+          className: sel && st.id === sel.id ? "sel" : "",
+        },
+      ]));
       const d = msg.drops;
       kv($("drops"), [
         ["queue full", fmt(d.queue_full), d.queue_full > 0],
@@ -110,25 +132,25 @@ export function createHealth(sendControl) {
         ["control refused", fmt(msg.control_refused), msg.control_refused > 0],
       ]);
       const lat = msg.latency || {};
-      $("t-latency").tBodies[0].replaceChildren(...[["received → processed", lat.processed], ["processed → sent", lat.sent]]
-        .map(([name, q]) => cells(document.createElement("tr"), [
+      rows($("t-latency").tBodies[0], [["received → processed", lat.processed], ["processed → sent", lat.sent]]
+        .map(([name, q]) => [[
           [name], [fmt(q && q.p50), "n"], [fmt(q && q.p99), "n"], [fmt(q && q.p50_all), "n"], [fmt(q && q.p99_all), "n"],
-        ])));
+        ]]));
       const badge = $("latency-badge");
       const p99 = lat.processed ? lat.processed.p99 : null;
-      badge.textContent = p99 === null ? "—" : `p99 ${fmt(p99)} µs`;
-      badge.className = "pill mono " + (p99 === null ? "" : p99 > 2000 ? "bad" : p99 > 500 ? "warn" : "on");
-      $("t-subs").tBodies[0].replaceChildren(...msg.subscribers.map((s) => cells(document.createElement("tr"), [
+      setText(badge, p99 === null ? "—" : `p99 ${fmt(p99)} µs`);
+      setClass(badge, "pill mono " + (p99 === null ? "" : p99 > 2000 ? "bad" : p99 > 500 ? "warn" : "on"));
+      rows($("t-subs").tBodies[0], msg.subscribers.map((s) => [[
         [s.address], [s.profile], [s.performer || "all"],
         [s.lease_ms === null ? "static" : `${(s.lease_ms / 1000).toFixed(1)} s`, "n"],
         [fmt(s.sends), "n"], [fmt(s.failures), "n"],
-      ])));
+      ]]));
       const rec = msg.recording;
       const state = $("rec-state");
-      state.textContent = rec ? `recording ${rec.path}${rec.raw ? ` + ${rec.raw}` : ""}` : "idle";
-      state.className = "pill " + (rec ? "bad" : "off");
+      setText(state, rec ? `recording ${rec.path}${rec.raw ? ` + ${rec.raw}` : ""}` : "idle");
+      setClass(state, "pill " + (rec ? "bad" : "off"));
       const mon = msg.monitor;
-      $("monitor-line").textContent = `monitor: ${mon.viewers} page(s) open · ${fmt(mon.dropped)} feed messages dropped for slow pages · ${fmt(mon.refused)} requests refused`;
+      setText($("monitor-line"), `monitor: ${mon.viewers} page(s) open · ${fmt(mon.dropped)} feed messages dropped for slow pages · ${fmt(mon.refused)} requests refused`);
       setModel(selected);
     },
   };

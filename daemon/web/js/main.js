@@ -157,7 +157,8 @@ function draw() {
   frames++;
   const now = performance.now();
   if (now - since >= 1000) {
-    $("rate").textContent = `${Math.round((frames * 1000) / (now - since))} fps`;
+    const rate = `${Math.round((frames * 1000) / (now - since))} fps`;
+    if ($("rate").textContent !== rate) $("rate").textContent = rate;
     frames = 0;
     since = now;
   }
