@@ -61,6 +61,11 @@ impl Run {
     }
 }
 
+/// Frames sent before each measured run and not measured (numbered below zero): what a round
+/// measures is the steady state, not a new daemon's first frames, nor a monitor page taking
+/// its first snapshots and models.
+const WARMUP: Duration = Duration::from_millis(250);
+
 /// How long a round with the monitor waits for a page to open.
 const PAGE_WAIT: Duration = Duration::from_secs(60);
 
@@ -181,7 +186,7 @@ pub(super) async fn receivers(k: usize) -> Result<(Receivers, Vec<SocketAddr>)> 
 
 /// Each frame carries its send time on the bench's clock in its capture-time field.
 fn time_frame(seen: &mut Seen, r: &Received<'_>) {
-    if let Some((header, _)) = r.frame {
+    if let Some((header, _)) = r.frame.filter(|(h, _)| h.frame_number >= 0) {
         seen.received += 1;
         let now = r.at.saturating_duration_since(epoch()).as_micros() as u64;
         Stats::record(
@@ -231,12 +236,13 @@ async fn send_all(
         sources.push((Source::new(&labels, socket, to, false)?, xyz));
     }
     let frames = (rate_hz * secs.as_secs_f64()) as usize;
+    let warmup = (rate_hz * WARMUP.as_secs_f64()) as usize;
     // Every frame is sent, however late: the max-rate run measures where frames go missing.
     let options = PacerOptions {
         max_behind_frames: u64::MAX,
         ..PacerOptions::default()
     };
-    let mut pacer = Pacer::new(rate_hz, frames.max(1), options)?;
+    let mut pacer = Pacer::new(rate_hz, (warmup + frames).max(1), options)?;
     let thread = tokio::task::spawn_blocking(move || {
         std::thread::sleep(Duration::from_millis(20));
         let mut sent = 0u64;
@@ -247,8 +253,10 @@ async fn send_all(
                     Due::Frame(f) => {
                         let t = epoch().elapsed().as_micros() as i64;
                         let errors = source.send_errors;
-                        source.send_frame(f.stream_index as i32, t, xyz, &[])?;
-                        sent += u64::from(source.send_errors == errors);
+                        // Warm-up frames are numbered below zero: the receivers skip them.
+                        let number = f.stream_index as i64 - warmup as i64;
+                        source.send_frame(number as i32, t, xyz, &[])?;
+                        sent += u64::from(source.send_errors == errors && number >= 0);
                     }
                 }
             }
