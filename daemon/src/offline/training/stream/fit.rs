@@ -124,7 +124,9 @@ fn whiten_pass(
         "restarts",
         None,
     );
-    fit.handle_whitened(sub).context("training failed")?;
+    // On the pool: the restarts run at once there, and --threads holds.
+    pool.install(|| fit.handle_whitened(sub))
+        .context("training failed")?;
     Ok(store)
 }
 
