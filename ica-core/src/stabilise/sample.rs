@@ -127,24 +127,23 @@ impl Sample {
             .flat_map_iter(|&m| {
                 let mut d2 = Vec::new();
                 (0..3)
-                    .filter_map(|axis| {
-                        d2.clear();
-                        for s in 0..self.frames() {
-                            let [b, a, n] = self.triple(s);
-                            if let (Some(p), Some(q), Some(r)) =
-                                (self.get(b, m), self.get(a, m), self.get(n, m))
-                            {
-                                d2.push(
-                                    f64::from(p[axis]) - 2.0 * f64::from(q[axis])
-                                        + f64::from(r[axis]),
-                                );
-                            }
-                        }
-                        (d2.len() >= 10).then(|| mad(&mut d2) / 6f64.sqrt())
-                    })
+                    .filter_map(|axis| self.axis_noise(m, axis, &mut d2))
                     .collect::<Vec<_>>()
             })
             .collect();
         median(&mut per_axis)
+    }
+
+    /// The robust spread of marker `m`'s second differences along `axis` / √6, from at least
+    /// 10 of them (`d2` is scratch).
+    fn axis_noise(&self, m: usize, axis: usize, d2: &mut Vec<f64>) -> Option<f64> {
+        d2.clear();
+        for s in 0..self.frames() {
+            let [b, a, n] = self.triple(s);
+            if let (Some(p), Some(q), Some(r)) = (self.get(b, m), self.get(a, m), self.get(n, m)) {
+                d2.push(f64::from(p[axis]) - 2.0 * f64::from(q[axis]) + f64::from(r[axis]));
+            }
+        }
+        (d2.len() >= 10).then(|| mad(d2) / 6f64.sqrt())
     }
 }

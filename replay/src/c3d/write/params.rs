@@ -99,22 +99,12 @@ impl Records {
 
     pub(super) fn int(&mut self, group: i8, name: &str, values: &[u16]) {
         let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let dims = if values.len() == 1 {
-            vec![]
-        } else {
-            vec![values.len() as u8]
-        };
-        self.param(group, name, 2, &dims, &data);
+        self.param(group, name, 2, &number_dims(values.len()), &data);
     }
 
     pub(super) fn float(&mut self, group: i8, name: &str, values: &[f32]) {
         let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let dims = if values.len() == 1 {
-            vec![]
-        } else {
-            vec![values.len() as u8]
-        };
-        self.param(group, name, 4, &dims, &data);
+        self.param(group, name, 4, &number_dims(values.len()), &data);
     }
 
     /// A character array of `strings.len()` strings, blank-padded to the longest (at least 1:
@@ -136,5 +126,15 @@ impl Records {
 
     pub(super) fn finish(self) -> Vec<u8> {
         self.buf
+    }
+}
+
+/// Dimensions of a numeric parameter of `count` values: none for a scalar, else one
+/// (callers write a few values at most).
+fn number_dims(count: usize) -> Vec<u8> {
+    if count == 1 {
+        vec![]
+    } else {
+        vec![count as u8]
     }
 }

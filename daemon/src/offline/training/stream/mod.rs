@@ -185,6 +185,9 @@ fn streamed(
     })
 }
 
+/// A batch prepared and not yet collected: its index and its takes.
+type Prepared = Option<(usize, Vec<read::PreparedTake>)>;
+
 /// Pass 2: every spilled frame prepared and collected; each reference marker's residual.
 fn statistics(
     scanned: &scan::Scan,
@@ -213,8 +216,8 @@ fn statistics(
     let record = 13 * scanned.first_markers;
     // Each batch is prepared on the pool while the previous one is collected here, so the
     // pool does not wait for the collecting (which writes the prepared spill).
-    let mut pending: Option<(usize, Vec<read::PreparedTake>)> = None;
-    let mut collect = |pending: Option<(usize, Vec<read::PreparedTake>)>,
+    let mut pending: Prepared = None;
+    let mut collect = |pending: Prepared,
                        collected: &mut Collected,
                        refs: &mut Option<RefResiduals<'_>>|
      -> Result<()> {
