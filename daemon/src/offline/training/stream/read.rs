@@ -15,13 +15,20 @@ use super::spill::f32_values;
 use crate::engine::frame::FramePrep;
 use crate::offline::ModelFrames;
 
-/// Consecutive items whose sizes add up to about `target` (at least one item each).
+/// Consecutive items whose sizes add up to about `target` (at least one item each). The first
+/// batches are smaller (a quarter, then half the target): the pipelines below work on one
+/// batch while the next loads, and nothing overlaps the first one's loading.
 pub(super) fn batches(sizes: &[u64], target: u64) -> Vec<Range<usize>> {
     let mut out = Vec::new();
     let (mut start, mut sum) = (0, 0u64);
     for (i, &size) in sizes.iter().enumerate() {
         sum += size;
-        if sum >= target {
+        let ramp = match out.len() {
+            0 => 4,
+            1 => 2,
+            _ => 1,
+        };
+        if sum >= target / ramp {
             out.push(start..i + 1);
             start = i + 1;
             sum = 0;
@@ -175,7 +182,12 @@ mod tests {
 
     #[test]
     fn batches_cover_every_item_once() {
-        assert_eq!(batches(&[5, 5, 5, 30, 1], 10), vec![0..2, 2..4, 4..5]);
+        assert_eq!(
+            batches(&[5, 5, 5, 30, 1], 40),
+            vec![0..2, 2..4, 4..5],
+            "a quarter, a half, then the target"
+        );
+        assert_eq!(batches(&[5; 12], 20), vec![0..1, 1..3, 3..7, 7..11, 11..12]);
         assert_eq!(batches(&[], 10), Vec::<Range<usize>>::new());
         assert_eq!(batches(&[100], 10), vec![0..1]);
     }

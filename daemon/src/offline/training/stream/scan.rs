@@ -80,6 +80,15 @@ pub(super) fn scan(
     let first = load_take(first_path)?;
     let rate_hz = prep.rate_hz.unwrap_or(first.rate_hz);
     let first_labels = first.labels.clone();
+    let sizes: Vec<u64> = paths
+        .iter()
+        .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
+        .collect();
+    // Holding takes that are dropped later only costs: hold none when the first take's
+    // frames per byte say the session is well past the limit.
+    let likely_frames = first.n_frames() as f64 * sizes.iter().sum::<u64>() as f64
+        / sizes.first().copied().unwrap_or(1).max(1) as f64;
+    let hold = likely_frames <= 2.0 * hold_frames as f64;
     drop(first);
     let mut counts = MissingCounts::new(first_labels.clone());
     let mut sampler = Sampler::new(sample_frames);
@@ -93,14 +102,10 @@ pub(super) fn scan(
         first_markers: first_labels.len(),
         kept: Vec::new(),
         raw: None,
-        held: Some(Vec::new()),
+        held: hold.then(Vec::new),
     };
     let mut bytes = Vec::new();
     let mut raw = Spill::new(first_labels.len() * 13)?;
-    let sizes: Vec<u64> = paths
-        .iter()
-        .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
-        .collect();
     let load = |i: usize| {
         let take = load_take(&paths[i])?;
         let at_rate = at_rate(&take, rate_hz);
