@@ -96,14 +96,16 @@ pub(super) struct Collected {
 }
 
 impl Collected {
-    /// An empty collection for `markers` markers over `total` frames at `rate_hz`.
-    pub(super) fn new(markers: usize, total: usize, rate_hz: f64) -> Result<Self> {
+    /// An empty collection for `markers` markers over `total` frames at `rate_hz`, spilling
+    /// the prepared frames over `raw`, which the caller reads once, frame by frame ahead of
+    /// them ([`Spill::overwrite`]).
+    pub(super) fn new(markers: usize, total: usize, rate_hz: f64, raw: &mut Spill) -> Result<Self> {
         let c = markers * 3;
         let slow_block = slow_block_frames(rate_hz);
         Ok(Self {
             channels: c,
             moments: Moments::new(c),
-            prepared: Spill::new(c * 4 + markers)?,
+            prepared: raw.overwrite(c * 4 + markers)?,
             gappy: Spill::new(c * 5)?,
             gap_missing: vec![0; c],
             left_out: 0,

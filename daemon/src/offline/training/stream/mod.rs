@@ -198,7 +198,8 @@ fn statistics(
 ) -> Result<(Collected, Option<BTreeMap<String, f64>>)> {
     let total = scanned.total_frames();
     progress.step("statistics", "frames", Some(total as u64));
-    let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz)?;
+    // The prepared frames go over the raw ones: each batch is collected after it was read.
+    let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz, &mut raw)?;
     let mut refs = learned.capture.head.as_ref().map(RefResiduals::new);
     let prep = TakePrep {
         kept: &scanned.kept,
@@ -252,6 +253,8 @@ fn statistics(
         Ok(())
     })?;
     collect(pending, &mut collected, &mut refs)?;
+    drop(raw);
+    collected.prepared.trim()?;
     let residuals = refs.map(|r| r.by_label(&scanned.labels));
     Ok((collected, residuals))
 }

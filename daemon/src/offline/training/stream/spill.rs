@@ -3,7 +3,8 @@
 //! crash), so memory holds one chunk whatever the session's length.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
+use std::io::{BufWriter, Seek, SeekFrom, Write};
+use std::os::unix::fs::FileExt;
 
 use anyhow::{Context, Result};
 
@@ -14,6 +15,8 @@ pub(super) struct Spill {
     record_bytes: usize,
     records: usize,
     buffer: Vec<u8>,
+    /// Another spill writes over this one's file ([`Spill::overwrite`]): read only.
+    overwritten: bool,
 }
 
 impl Spill {
@@ -28,7 +31,55 @@ impl Spill {
             record_bytes: record_bytes.max(1),
             records: 0,
             buffer: Vec::new(),
+            overwritten: false,
         })
+    }
+
+    /// A new, empty spill of records of `record_bytes` bytes (at most this one's) that writes
+    /// over this one's file from its start, for a pass that reads this spill once, in order,
+    /// and writes record `k` only after reading record `k` of this one: the records it writes
+    /// are never longer, so they never reach what is still unread. One file instead of two
+    /// halves the temporary space and the page cache a long session dirties. This spill stays
+    /// readable, and can no longer be written.
+    ///
+    /// # Errors
+    /// Records longer than this spill's, or the file failing.
+    pub(super) fn overwrite(&mut self, record_bytes: usize) -> Result<Self> {
+        anyhow::ensure!(
+            record_bytes <= self.record_bytes,
+            "records of {record_bytes} bytes cannot overwrite records of {}",
+            self.record_bytes
+        );
+        self.file.flush().context("cannot write the spill file")?;
+        self.overwritten = true;
+        // The handles share the file offset: this spill reads at positions and never writes.
+        let mut file = self
+            .file
+            .get_ref()
+            .try_clone()
+            .context("cannot reopen the spill file")?;
+        file.seek(SeekFrom::Start(0))
+            .context("cannot write the spill file")?;
+        Ok(Self {
+            file: BufWriter::with_capacity(1 << 20, file),
+            record_bytes: record_bytes.max(1),
+            records: 0,
+            buffer: Vec::new(),
+            overwritten: false,
+        })
+    }
+
+    /// Cuts the file after the last record written (what an overwritten spill left behind).
+    ///
+    /// # Errors
+    /// The file failing.
+    pub(super) fn trim(&mut self) -> Result<()> {
+        self.file.flush().context("cannot write the spill file")?;
+        let end = (self.records * self.record_bytes) as u64;
+        self.file
+            .get_ref()
+            .set_len(end)
+            .context("cannot trim the spill file")
     }
 
     /// Bytes per record.
@@ -47,6 +98,10 @@ impl Spill {
     /// Writing fails (a full disk).
     pub(super) fn push(&mut self, bytes: &[u8]) -> Result<()> {
         debug_assert_eq!(bytes.len() % self.record_bytes, 0);
+        anyhow::ensure!(
+            !self.overwritten,
+            "a spill another one overwrites cannot grow"
+        );
         self.file
             .write_all(bytes)
             .context("cannot write the spill file")?;
@@ -66,20 +121,18 @@ impl Spill {
     ) -> Result<()> {
         debug_assert_eq!(groups.iter().sum::<usize>(), self.records);
         self.file.flush().context("cannot write the spill file")?;
-        let file = self.file.get_mut();
-        file.seek(SeekFrom::Start(0))
-            .context("cannot read the spill file")?;
-        let mut reader = BufReader::with_capacity(1 << 20, &*file);
+        // Reads at positions: the file offset stays where the next record is appended (or
+        // where a spill overwriting this one writes).
+        let mut at = 0u64;
         for (i, &n) in groups.iter().enumerate() {
             self.buffer.resize(n * self.record_bytes, 0);
-            reader
-                .read_exact(&mut self.buffer)
+            self.file
+                .get_ref()
+                .read_exact_at(&mut self.buffer, at)
                 .context("cannot read the spill file")?;
+            at += self.buffer.len() as u64;
             each(i, &self.buffer)?;
         }
-        drop(reader);
-        file.seek(SeekFrom::End(0))
-            .context("cannot write the spill file")?;
         Ok(())
     }
 
@@ -142,5 +195,52 @@ mod tests {
                 .expect("reads");
             assert_eq!(back, values);
         }
+    }
+
+    #[test]
+    fn an_overwriting_spill_reads_the_old_records_and_keeps_its_own() {
+        let mut old = Spill::new(8).expect("temp file");
+        let values: Vec<f32> = (0..3_000 * 2).map(|i| i as f32).collect();
+        let mut bytes = Vec::new();
+        f32_bytes(&values, &mut bytes);
+        old.push(&bytes).expect("writes");
+        assert!(
+            old.overwrite(12).is_err(),
+            "longer records would overtake the reader"
+        );
+        let mut new = old.overwrite(4).expect("same file");
+        // Each record's first value, written as soon as it is read, in chunks of 700.
+        let mut seen = Vec::new();
+        old.for_each_chunk(700, &mut |b| {
+            let mut chunk = Vec::new();
+            f32_values(b, &mut chunk);
+            let firsts: Vec<f32> = chunk.chunks_exact(2).map(|p| p[0]).collect();
+            seen.extend_from_slice(&chunk);
+            let mut out = Vec::new();
+            f32_bytes(&firsts, &mut out);
+            new.push(&out)
+        })
+        .expect("reads and writes");
+        assert_eq!(seen, values, "the reader saw the old records intact");
+        assert!(old.push(&bytes[..8]).is_err(), "the old spill is read only");
+        drop(old);
+        new.trim().expect("trims");
+        assert_eq!(
+            new.file.get_ref().metadata().expect("meta").len(),
+            3_000 * 4
+        );
+        let mut back = Vec::new();
+        new.for_each_chunk(1_000, &mut |b| {
+            let mut chunk = Vec::new();
+            f32_values(b, &mut chunk);
+            back.extend_from_slice(&chunk);
+            Ok(())
+        })
+        .expect("reads");
+        let want: Vec<f32> = values.chunks_exact(2).map(|p| p[0]).collect();
+        assert_eq!(back, want);
+        // And it appends after its own records.
+        new.push(&bytes[..4]).expect("appends");
+        assert_eq!(new.records(), 3_001);
     }
 }
