@@ -4,6 +4,7 @@
 use std::ops::Range;
 
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 use crate::model::IcaModel;
 use crate::robust::{mad, median};
@@ -268,8 +269,9 @@ pub fn noise_per_coordinate(data: &TrainingFrames<'_>) -> f64 {
 /// [`noise_per_coordinate`] from the second differences of each channel, as a streaming
 /// caller collects them.
 pub fn noise_of_differences(per_channel: &mut [Vec<f64>]) -> f64 {
+    // Channel by channel on the current rayon pool (collected in order).
     let mut spread: Vec<f64> = per_channel
-        .iter_mut()
+        .par_iter_mut()
         .filter(|d2| d2.len() >= 10)
         .map(|d2| mad(d2) / 6f64.sqrt())
         .collect();

@@ -38,11 +38,11 @@ pub(super) fn learn(
     let n = labels.len();
     // 1. The head: decided on the raw frames, template from them (its Procrustes mean shrugs
     //    off rare glitches).
-    let raw_missing: Vec<bool> = frames
-        .iter()
-        .flat_map(|f| f.missing.iter().copied())
-        .collect();
-    let raw_xyz: Vec<f32> = frames.iter().flat_map(|f| f.xyz.iter().copied()).collect();
+    let (mut raw_xyz, mut raw_missing) = (Vec::new(), Vec::new());
+    for f in frames {
+        raw_xyz.extend_from_slice(&f.xyz);
+        raw_missing.extend_from_slice(&f.missing);
+    }
     let mut ranges = Vec::with_capacity(frames.len());
     let mut start = 0;
     for f in frames {

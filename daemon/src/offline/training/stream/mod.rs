@@ -115,7 +115,7 @@ fn streamed(
     let total = scanned.total_frames();
     let (scanned, raw) = scanned.take_raw()?;
     let (mut collected, head_residuals) = statistics(&scanned, raw, &learned, pool, progress)?;
-    let noise_mm = noise_of_differences(&mut collected.noise_d2);
+    let noise_mm = pool.install(|| noise_of_differences(&mut collected.noise_d2));
     let params = component_params(options, noise_mm);
     // Pass 3: the gaps.
     let filled = gaps::fill(&mut collected, params.get_components(), pool, progress)?;
@@ -145,12 +145,13 @@ fn streamed(
         head.residual_mm = residuals;
     }
     let c = collected.channels;
+    let (residual_by_marker_mm, slow_residual) = pool.join(
+        || residual_by_marker_of(&model, collected.residual_frames.chunks_exact(c)),
+        || slow_residual_of_means(&model, &collected.slow_means),
+    );
     let measures = Measures {
-        residual_by_marker_mm: residual_by_marker_of(
-            &model,
-            collected.residual_frames.chunks_exact(c),
-        ),
-        slow_residual: slow_residual_of_means(&model, &collected.slow_means),
+        residual_by_marker_mm,
+        slow_residual,
         noise_mm,
     };
     model.set_quality(quality::assess_measured(
