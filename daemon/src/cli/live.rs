@@ -1,4 +1,7 @@
 //! The arguments of the live commands: the service, its bench, replays and the demo.
+//!
+//! The argument docs are clap's help text, where `[..]` marks an optional part, not a link.
+#![allow(rustdoc::broken_intra_doc_links)]
 
 use std::path::PathBuf;
 

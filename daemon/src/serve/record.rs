@@ -80,7 +80,7 @@ impl StreamFiles {
     }
 }
 
-/// One recording in progress (bounded memory: [`Recorder`] streams to disk).
+/// One recording in progress (bounded memory: [`replay::record::Recorder`] streams to disk).
 #[derive(Debug)]
 pub struct Recording {
     path: PathBuf,

@@ -8,6 +8,8 @@ use super::version::NatNetVersion;
 
 /// Timing and identity of a [`Client`]. Defaults: NatNet 3.0 connect, 1 s for every retry and
 /// period, 3 s of silence before a reconnect, clock estimate over the last 8 echoes.
+///
+/// [`Client`]: super::Client
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ClientConfig {
     /// Version announced in the connect; from 4.0 it also asks for that bitstream version.
@@ -44,16 +46,23 @@ impl Default for ClientConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Channel {
     /// The command socket (replies to what [`Client::poll_transmit`] sent).
+    ///
+    /// [`Client::poll_transmit`]: super::Client::poll_transmit
     Command,
     /// The data socket (frames; multicast or unicast).
     Data,
 }
 
 /// What [`Client::handle_datagram`] made of a datagram.
+///
+/// [`Client::handle_datagram`]: super::Client::handle_datagram
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Incoming {
     /// A NAT_FRAMEOFDATA: decode it with [`Client::frame_version`], then call
     /// [`Client::handle_frame`].
+    ///
+    /// [`Client::frame_version`]: super::Client::frame_version
+    /// [`Client::handle_frame`]: super::Client::handle_frame
     Frame,
     /// A command message, handled (its effects come out of `poll_event`/`poll_transmit`).
     Handled,

@@ -11,7 +11,7 @@
 //!   health (`status`) four times a second;
 //! - `socket`: one page's WebSocket: the feed out, control messages in. Controls are OSC
 //!   messages, exactly as the control socket takes them, through the same guard (allow-list,
-//!   secret) and the same [`execute`](super::control::execute), so a page and an OSC client
+//!   secret) and the same `control::execute`, so a page and an OSC client
 //!   never disagree;
 //! - `access`: loopback by default; beyond loopback (or with `monitor_token` set) a token,
 //!   given once as `?token=` and then kept in a cookie; Host and Origin checked;
