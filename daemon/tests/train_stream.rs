@@ -41,6 +41,7 @@ fn streamed(paths: &[PathBuf], options: &TrainOptions, threads: usize) -> Traine
     let stream = StreamOptions {
         threads,
         always_stream: true,
+        hold_frames: None,
     };
     training::train_files(paths, options, &stream, &mut Silent).expect("trains streaming")
 }
@@ -134,4 +135,43 @@ fn issue_18_train_shows_progress_in_a_pipe() {
         ],
     );
     assert!(std::fs::metadata(&model).is_ok());
+}
+
+/// The first pass guesses a session's length from its first take's frames per byte and holds
+/// nothing when the guess is well past the in-memory limit; a short session guessed long
+/// (here the second take carries 400 markers the first does not, so its bytes say eleven
+/// times its frames) is read again and trained in memory: the path depends on frames only.
+#[test]
+fn a_short_session_guessed_long_from_its_file_sizes_still_trains_in_memory() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let sing = offline::load_take(&facial_sing()[0]).expect("fixture loads");
+    let frames = 300;
+    let mut first = replay::Take::new(sing.labels.clone(), sing.rate_hz, 1);
+    let mut labels = sing.labels.clone();
+    labels.extend((0..400).map(|i| format!("extra{i}")));
+    let mut bulky = replay::Take::new(labels, sing.rate_hz, 1);
+    for f in 0..frames {
+        first.push_frame(sing.frame(f), sing.frame_missing(f));
+        let g = frames + f;
+        let mut xyz = sing.frame(g).to_vec();
+        let mut missing = sing.frame_missing(g).to_vec();
+        xyz.extend((0..400 * 3).map(|i| 1.0 + i as f32));
+        missing.extend([false; 400]);
+        bulky.push_frame(&xyz, &missing);
+    }
+    let paths = [dir.path().join("a.c3d"), dir.path().join("b.c3d")];
+    replay::save(&paths[0], &first).expect("writes");
+    replay::save(&paths[1], &bulky).expect("writes");
+    let options = TrainOptions::default();
+    let stream = StreamOptions {
+        threads: 1,
+        always_stream: false,
+        hold_frames: Some(2 * frames),
+    };
+    let got = training::train_files(&paths, &options, &stream, &mut Silent).expect("trains");
+    let want = in_memory(&paths, &options);
+    // The in-memory path on the same takes: the same numbers, not merely close ones.
+    let apart = (got.model.mixing() - want.model.mixing()).amax();
+    assert!(apart == 0.0, "streamed, not held: mixing {apart:e} apart");
+    assert_eq!(got.model.mean(), want.model.mean());
 }

@@ -128,6 +128,7 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     let stream = StreamOptions {
         threads: args.threads,
         always_stream: args.stream,
+        hold_frames: None,
     };
     let started = Instant::now();
     let mut progress = super::progress::for_stderr("train");

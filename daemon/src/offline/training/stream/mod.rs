@@ -39,6 +39,7 @@ use super::model::{capped_at_noise, component_params};
 use super::quality::{self, Measures};
 use super::{residual_summary, PrepReport, Stage, TrainOptions, Trained};
 use crate::offline::progress::Progress;
+use crate::offline::{load_take, LoadedTake};
 use collect::Collected;
 use rayon::prelude::*;
 use read::{batches, TakePrep};
@@ -58,6 +59,8 @@ pub struct StreamOptions {
     pub threads: usize,
     /// Stream even a session short enough to train in memory.
     pub always_stream: bool,
+    /// Sessions of at most this many frames train in memory (`None`: [`IN_MEMORY_FRAMES`]).
+    pub hold_frames: Option<usize>,
 }
 
 /// Trains a model on the takes in `paths`, streaming them unless the session is short (see
@@ -79,9 +82,24 @@ pub fn train_files(
     let hold = if stream.always_stream {
         0
     } else {
-        IN_MEMORY_FRAMES
+        stream.hold_frames.unwrap_or(IN_MEMORY_FRAMES)
     };
-    let scanned = scan::scan(paths, &options.prep, hold, SAMPLE_FRAMES, &pool, progress)?;
+    let mut scanned = scan::scan(paths, &options.prep, hold, SAMPLE_FRAMES, &pool, progress)?;
+    if scanned.held.is_none() && scanned.total_frames() <= hold {
+        // The scan guessed the session long from its files' sizes: read it again to hold it,
+        // so which path trains a session depends on its frames only.
+        progress.step("reading takes again to hold them", "takes", None);
+        let takes = paths
+            .iter()
+            .map(|p| {
+                Ok(LoadedTake {
+                    path: p.clone(),
+                    take: load_take(p)?,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        scanned.held = Some(takes);
+    }
     if let Some(takes) = &scanned.held {
         let mut stage = |s: Stage| match s {
             Stage::Preparing => progress.step("preparing in memory", "takes", None),

@@ -85,9 +85,11 @@ pub(super) fn scan(
         .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
         .collect();
     // Holding takes that are dropped later only costs: hold none when the first take's
-    // frames per byte say the session is well past the limit.
-    let likely_frames = first.n_frames() as f64 * sizes.iter().sum::<u64>() as f64
-        / sizes.first().copied().unwrap_or(1).max(1) as f64;
+    // frames per byte (at the model rate) say the session is well past the limit. A wrong
+    // guess costs time, not the model: a short session found streamed is read again.
+    let likely_frames =
+        first.n_frames() as f64 * (rate_hz / first.rate_hz) * sizes.iter().sum::<u64>() as f64
+            / sizes.first().copied().unwrap_or(1).max(1) as f64;
     let hold = likely_frames <= 2.0 * hold_frames as f64;
     drop(first);
     let mut counts = MissingCounts::new(first_labels.clone());
