@@ -26,13 +26,18 @@ impl Spill {
     /// The temporary file cannot be created.
     pub(super) fn new(record_bytes: usize) -> Result<Self> {
         let file = tempfile::tempfile().context("cannot create a temporary spill file")?;
-        Ok(Self {
+        Ok(Self::on(file, record_bytes))
+    }
+
+    /// An empty spill of records of `record_bytes` bytes writing at `file`'s offset.
+    fn on(file: File, record_bytes: usize) -> Self {
+        Self {
             file: BufWriter::with_capacity(1 << 20, file),
             record_bytes: record_bytes.max(1),
             records: 0,
             buffer: Vec::new(),
             overwritten: false,
-        })
+        }
     }
 
     /// A new, empty spill of records of `record_bytes` bytes (at most this one's) that writes
@@ -60,13 +65,7 @@ impl Spill {
             .context("cannot reopen the spill file")?;
         file.seek(SeekFrom::Start(0))
             .context("cannot write the spill file")?;
-        Ok(Self {
-            file: BufWriter::with_capacity(1 << 20, file),
-            record_bytes: record_bytes.max(1),
-            records: 0,
-            buffer: Vec::new(),
-            overwritten: false,
-        })
+        Ok(Self::on(file, record_bytes))
     }
 
     /// Cuts the file after the last record written (what an overwritten spill left behind).
