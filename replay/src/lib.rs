@@ -24,5 +24,5 @@ pub mod take;
 pub mod trc;
 
 pub use error::{ReadError, TakeError, WriteError};
-pub use format::{load, load_limited, save, write_as, Format};
+pub use format::{load, load_limited, load_with, save, write_as, C3dDecoding, Format};
 pub use take::{Take, Units};

@@ -41,6 +41,24 @@ fn samples_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/c3d-samples")
 }
 
+/// Every C3D file under `dir`, sorted; `None` when the folder is absent, which fails in CI.
+fn sample_files(dir: &Path) -> Option<Vec<PathBuf>> {
+    if !dir.is_dir() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "{} absent in CI: put ../shared beside the checkout",
+            dir.display()
+        );
+        eprintln!("{} absent: nothing to walk", dir.display());
+        return None;
+    }
+    let mut files = Vec::new();
+    walk(dir, &mut files);
+    files.sort();
+    assert!(files.len() >= TABLE.len(), "found {} files", files.len());
+    Some(files)
+}
+
 fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
@@ -61,14 +79,9 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
 #[test]
 fn every_sample_file_matches_the_verified_table_or_fails_cleanly() {
     let dir = samples_dir();
-    if !dir.is_dir() {
-        eprintln!("{} absent: nothing to walk", dir.display());
+    let Some(files) = sample_files(&dir) else {
         return;
-    }
-    let mut files = Vec::new();
-    walk(&dir, &mut files);
-    files.sort();
-    assert!(files.len() >= TABLE.len(), "found {} files", files.len());
+    };
     let mut problems = Vec::new();
     for path in &files {
         let rel = path.strip_prefix(&dir).expect("walked under dir");
@@ -98,4 +111,27 @@ fn every_sample_file_matches_the_verified_table_or_fails_cleanly() {
         }
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// Training decodes C3D points with emoshift's own decoder alone; on every sample file the
+/// cross-checked reader accepts, it gives the same take, value for value.
+#[test]
+fn the_own_decoder_alone_reads_what_the_cross_checked_reader_reads() {
+    let dir = samples_dir();
+    let Some(files) = sample_files(&dir) else {
+        return;
+    };
+    let limit = replay::file::DEFAULT_MAX_TAKE_BYTES;
+    let mut compared = 0;
+    for path in &files {
+        let Ok(checked) = replay::load(path) else {
+            continue;
+        };
+        let own = replay::load_with(path, limit, replay::C3dDecoding::Own)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        // Positions are finite (missing samples are stored as 0.0), so equality is exact.
+        assert!(own == checked, "{}: the takes differ", path.display());
+        compared += 1;
+    }
+    assert!(compared >= TABLE.len(), "compared {compared} files");
 }

@@ -13,7 +13,7 @@ pub mod takes;
 pub mod training;
 
 pub use takes::{
-    input_paths, load_inputs, load_model, load_model_limited, load_session, load_take, match_take,
-    project_take, resynthesise, set_input_limit, to_model_order, LoadedTake, ModelFrames,
-    Projected,
+    input_paths, load_inputs, load_model, load_model_limited, load_session, load_take,
+    load_take_with, match_take, project_take, resynthesise, set_input_limit, to_model_order,
+    LoadedTake, ModelFrames, Projected,
 };

@@ -42,8 +42,16 @@ pub fn input_limit() -> u64 {
 /// # Errors
 /// Unreadable, malformed or empty file.
 pub fn load_take(path: &Path) -> Result<Take> {
-    let take =
-        replay::load_limited(path, input_limit()).with_context(|| format!("{}", path.display()))?;
+    load_take_with(path, replay::C3dDecoding::CrossChecked)
+}
+
+/// [`load_take`], decoding a C3D file's points as `decoding` says.
+///
+/// # Errors
+/// As [`load_take`].
+pub fn load_take_with(path: &Path, decoding: replay::C3dDecoding) -> Result<Take> {
+    let take = replay::load_with(path, input_limit(), decoding)
+        .with_context(|| format!("{}", path.display()))?;
     if take.n_frames() == 0 {
         bail!("{}: take has no frames", path.display());
     }

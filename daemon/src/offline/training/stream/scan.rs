@@ -17,7 +17,7 @@ use crate::engine::layout::LabelMap;
 use crate::offline::progress::Progress;
 use crate::offline::takes::frames_in_model_order;
 use crate::offline::training::{MissingCounts, PrepOptions};
-use crate::offline::{load_take, LoadedTake, ModelFrames};
+use crate::offline::{load_take_with, LoadedTake, ModelFrames};
 
 /// Bytes of take files loaded at once in the first pass.
 const SCAN_BATCH_BYTES: u64 = 16 << 20;
@@ -77,7 +77,7 @@ pub(super) fn scan(
 ) -> Result<Scan> {
     progress.step("reading takes", "takes", Some(paths.len() as u64));
     let first_path = paths.first().context("no takes given")?;
-    let first = load_take(first_path)?;
+    let first = load_take_with(first_path, super::DECODING)?;
     let rate_hz = prep.rate_hz.unwrap_or(first.rate_hz);
     let first_labels = first.labels.clone();
     let sizes: Vec<u64> = paths
@@ -109,7 +109,7 @@ pub(super) fn scan(
     let mut bytes = Vec::new();
     let mut raw = Spill::new(first_labels.len() * 13)?;
     let load = |i: usize| {
-        let take = load_take(&paths[i])?;
+        let take = load_take_with(&paths[i], super::DECODING)?;
         let at_rate = at_rate(&take, rate_hz);
         Ok((take, at_rate))
     };
