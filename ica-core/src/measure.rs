@@ -82,34 +82,67 @@ pub fn residual_by_marker_of<'a>(
     model: &IcaModel,
     frames: impl Iterator<Item = &'a [f32]>,
 ) -> Vec<f64> {
-    let c = model.channels();
-    let mut sq = vec![0.0; model.markers()];
-    let mut count = 0usize;
-    let mut block: Vec<f64> = Vec::with_capacity(RESIDUAL_BLOCK * c);
-    let mut add = |block: &mut Vec<f64>| {
-        let mut r = DMatrix::from_vec(c, block.len() / c, std::mem::take(block));
-        residual_columns(model, &mut r);
-        for frame in r.column_iter() {
-            for (k, s) in sq.iter_mut().enumerate() {
-                *s += frame[3 * k].powi(2) + frame[3 * k + 1].powi(2) + frame[3 * k + 2].powi(2);
+    ResidualSums::of(model, frames).rms()
+}
+
+/// Per marker, the squared 3-D residual summed over frames, and the frames: what
+/// [`residual_by_marker_of`] averages, in parts that add (for a caller that splits the
+/// frames between threads).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResidualSums {
+    sq: Vec<f64>,
+    frames: usize,
+}
+
+impl ResidualSums {
+    /// The sums over the complete frames given (`channels` values each).
+    pub fn of<'a>(model: &IcaModel, frames: impl Iterator<Item = &'a [f32]>) -> ResidualSums {
+        let c = model.channels();
+        let mut sums = ResidualSums {
+            sq: vec![0.0; model.markers()],
+            frames: 0,
+        };
+        let mut block: Vec<f64> = Vec::with_capacity(RESIDUAL_BLOCK * c);
+        let mut add = |block: &mut Vec<f64>| {
+            let mut r = DMatrix::from_vec(c, block.len() / c, std::mem::take(block));
+            residual_columns(model, &mut r);
+            for frame in r.column_iter() {
+                for (k, s) in sums.sq.iter_mut().enumerate() {
+                    *s +=
+                        frame[3 * k].powi(2) + frame[3 * k + 1].powi(2) + frame[3 * k + 2].powi(2);
+                }
+            }
+            sums.frames += r.ncols();
+            *block = r.data.into();
+            block.clear();
+        };
+        for x in frames {
+            block.extend(x.iter().map(|&v| f64::from(v)));
+            if block.len() == RESIDUAL_BLOCK * c {
+                add(&mut block);
             }
         }
-        count += r.ncols();
-        *block = r.data.into();
-        block.clear();
-    };
-    for x in frames {
-        block.extend(x.iter().map(|&v| f64::from(v)));
-        if block.len() == RESIDUAL_BLOCK * c {
+        if !block.is_empty() {
             add(&mut block);
         }
+        sums
     }
-    if !block.is_empty() {
-        add(&mut block);
+
+    /// Adds the sums of other frames.
+    pub fn add(&mut self, other: &ResidualSums) {
+        for (a, b) in self.sq.iter_mut().zip(&other.sq) {
+            *a += b;
+        }
+        self.frames += other.frames;
     }
-    sq.iter()
-        .map(|s| (s / count.max(1) as f64).sqrt())
-        .collect()
+
+    /// Each marker's RMS residual (mm); 0 without frames.
+    pub fn rms(&self) -> Vec<f64> {
+        self.sq
+            .iter()
+            .map(|s| (s / self.frames.max(1) as f64).sqrt())
+            .collect()
+    }
 }
 
 /// Window of the slow residual's low pass (seconds): expressions and moods, not speech.
@@ -327,6 +360,16 @@ mod tests {
             }
         }
         let got = residual_by_marker_of(&model, frames.iter().map(Vec::as_slice));
+        // In two parts that add, as a caller splitting the frames between threads sums them.
+        let (a, b) = frames.split_at(RESIDUAL_BLOCK + 5);
+        let mut parts = ResidualSums::of(&model, a.iter().map(Vec::as_slice));
+        parts.add(&ResidualSums::of(&model, b.iter().map(Vec::as_slice)));
+        for (k, (x, y)) in got.iter().zip(parts.rms()).enumerate() {
+            assert!(
+                (x - y).abs() <= 1e-12 * x,
+                "marker {k}: {x} vs {y} in parts"
+            );
+        }
         for (k, s) in sq.iter().enumerate() {
             let want = (s / frames.len() as f64).sqrt();
             assert!(want > 1.0, "the residual is not trivial");

@@ -30,7 +30,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use ica_core::measure::{noise_of_differences, residual_by_marker_of, slow_residual_of_means};
+use ica_core::measure::{noise_of_differences, slow_residual_of_means, ResidualSums};
 use ica_core::model::IcaModel;
 use rayon::ThreadPool;
 
@@ -166,11 +166,22 @@ fn streamed(
     if let Some(residuals) = head_residuals {
         head.residual_mm = residuals;
     }
+    // The residual's two halves and the slow residual at once; the halves are fixed, so the
+    // sums do not depend on the thread count.
     let c = collected.channels;
-    let (residual_by_marker_mm, slow_residual) = pool.join(
-        || residual_by_marker_of(&model, collected.residual_frames.chunks_exact(c)),
+    let frames = &collected.residual_frames;
+    let (left, right) = frames.split_at(frames.len() / c / 2 * c);
+    let ((mut sums, right), slow_residual) = pool.join(
+        || {
+            pool.join(
+                || ResidualSums::of(&model, left.chunks_exact(c)),
+                || ResidualSums::of(&model, right.chunks_exact(c)),
+            )
+        },
         || slow_residual_of_means(&model, &collected.slow_means),
     );
+    sums.add(&right);
+    let residual_by_marker_mm = sums.rms();
     let measures = Measures {
         residual_by_marker_mm,
         slow_residual,
