@@ -45,6 +45,18 @@ def spread(values):
     return f"{statistics.median(values):.2f} ({min(values):.2f}-{max(values):.2f})"
 
 
+def cpu_per_frame(runs):
+    """Median CPU time (user + system, both cores) per frame, µs; — for older results."""
+    cpu = [r[4] / r[2] for r in runs if len(r) > 4]
+    return f"{1e6 * statistics.median(cpu):.1f}" if cpu else "—"
+
+
+def iterations(runs):
+    """FastICA's iterations over all frames, as one number or a range; — for older results."""
+    its = sorted({int(r[5]) for r in runs if len(r) > 5})
+    return "—" if not its else str(its[0]) if len(its) == 1 else f"{its[0]}-{its[-1]}"
+
+
 def report(path):
     train, sk, one = {}, {}, {}
     with open(path) as f:
@@ -57,8 +69,9 @@ def report(path):
             else:
                 sk.setdefault(size, []).append([float(v) for v in rest])
     print("\n| session | frames | train wall s, median (min-max) | peak RSS MB | frames/s | "
-          "µs per frame | sklearn fit s | sklearn RSS MB | sklearn iterations |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "µs per frame | CPU µs per frame | CPU stolen | FastICA iterations | sklearn fit s | "
+          "sklearn RSS MB | sklearn iterations |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     points = []
     for size, runs in train.items():
         frames = int(runs[0][2])
@@ -72,8 +85,10 @@ def report(path):
         if s:
             sk_cols = (f" {spread([r[0] for r in s])} | {max(r[1] for r in s) / 1024:.0f} | "
                        f"{int(s[0][3])}{'' if s[0][4] else ' (not converged)'} ")
+        # Stolen CPU time (both cores) as a share of the wall time, summed over the runs.
+        stolen = sum(r[3] for r in runs if len(r) > 3) / sum(walls)
         print(f"| {size} | {frames:,} | {spread(walls)} | {rss:.0f} | {frames / med:,.0f} | "
-              f"{1e6 * med / frames:.1f} |{sk_cols}|")
+              f"{1e6 * med / frames:.1f} | {cpu_per_frame(runs)} | {100 * stolen:.1f} % | {iterations(runs)} |{sk_cols}|")
     if len(points) >= 2:
         xs = [math.log(f) for f, _ in points]
         ys = [math.log(t) for _, t in points]
@@ -82,6 +97,17 @@ def report(path):
         per = [t / f for f, t in points]
         print(f"\nscaling exponent (time ~ frames^k): k = {slope:.3f}; time per frame, largest "
               f"session / smallest: {per[-1] / per[0]:.3f}")
+        # Run by run (the sizes took turns), so drift over minutes falls on both alike.
+        sizes = [size for size in train if size != "12k"]
+        small, large = train[sizes[0]], train[sizes[-1]]
+        for name, col in (("wall time", 0), ("CPU time", 4)):
+            pairs = [(a, b) for a, b in zip(small, large) if len(a) > col and len(b) > col]
+            if not pairs:
+                continue
+            ratios = [(a[col] / a[2]) / (b[col] / b[2]) for a, b in pairs]
+            print(f"{name} per frame, {sizes[0]} / {sizes[-1]}, run by run: "
+                  f"{' '.join(f'{r:.2f}' for r in ratios)} "
+                  f"(median {statistics.median(ratios):.2f})")
     for size, r in one.items():
         two = statistics.median(x[0] for x in train[size])
         print(f"{size} on one thread: {r[0]:.2f} s; on all cores {two:.2f} s ({r[0] / two:.2f}x speed-up)")
