@@ -8,7 +8,7 @@ use ica_core::fit::{FastIcaParams, FitData, FitOutput, Pass, StreamFit};
 use ica_core::whiten::Moments;
 use rayon::ThreadPool;
 
-use super::spill::{f32_bytes, f32_values, Spill};
+use super::whitened::{Whitened, HELD_BYTES};
 use crate::offline::progress::Progress;
 
 /// Whitened frames read back at once.
@@ -56,7 +56,7 @@ pub(super) fn fit(
                 progress.step(
                     "components' statistics",
                     "frames",
-                    Some(store.records() as u64),
+                    Some(store.frames() as u64),
                 );
                 let empty = fit.source_moments()?;
                 let mut sums = empty.clone();
@@ -66,7 +66,7 @@ pub(super) fn fit(
                     Ok(part)
                 };
                 for_each_half(&mut store, pool, &map, &mut |part| Ok(sums.merge(part)?))?;
-                progress.advance(store.records() as u64);
+                progress.advance(store.frames() as u64);
                 fit.handle_sources(sums).context("training failed")?;
             }
             Pass::Done => return Ok(fit.finish()?),
@@ -84,13 +84,13 @@ fn whiten_pass(
     source: &mut WhitenSource<'_>,
     pool: &ThreadPool,
     progress: &mut dyn Progress,
-) -> Result<Spill> {
+) -> Result<Whitened> {
     progress.step("whitening", "frames", Some(frames as u64));
     let whitener = fit.whitener().context("whitening is fitted")?.clone();
     let (c, m) = (whitener.channels(), whitener.components());
     let mut sub = fit.subsample()?;
-    let mut store = Spill::new(4 * m)?;
-    let (mut bytes, mut narrow) = (Vec::new(), Vec::<f32>::new());
+    let mut store = Whitened::new(m, CHUNK_FRAMES, HELD_BYTES)?;
+    let mut narrow = Vec::<f32>::new();
     source(&mut |values, mask| {
         let n = values.len() / c;
         let mid = n / 2;
@@ -107,10 +107,7 @@ fn whiten_pass(
             sub.push(&z)?;
             narrow.clear();
             narrow.extend(z.iter().map(|&v| v as f32));
-            let z = &narrow;
-            bytes.clear();
-            f32_bytes(z, &mut bytes);
-            store.push(&bytes)?;
+            store.push(&narrow)?;
         }
         progress.advance(n as u64);
         Ok(())
@@ -130,18 +127,16 @@ fn whiten_pass(
     Ok(store)
 }
 
-/// One pass over the spilled frames: `map` on both halves of each chunk at once, `merge` on
+/// One pass over the whitened frames: `map` on both halves of each chunk at once, `merge` on
 /// the results in order.
 fn for_each_half<T: Send>(
-    store: &mut Spill,
+    store: &mut Whitened,
     pool: &ThreadPool,
     map: &(dyn Fn(&[f32]) -> Result<T> + Sync),
     merge: &mut dyn FnMut(T) -> Result<()>,
 ) -> Result<()> {
-    let mut z = Vec::new();
-    let m = store.record_bytes() / 4;
-    store.for_each_chunk(CHUNK_FRAMES, &mut |bytes| {
-        f32_values(bytes, &mut z);
+    let m = store.width();
+    store.for_each_chunk(&mut |z| {
         let (left, right) = z.split_at((z.len() / m) / 2 * m);
         let (a, b) = pool.join(|| map(left), || map(right));
         merge(a?)?;

@@ -25,6 +25,7 @@ mod read;
 mod sample;
 mod scan;
 mod spill;
+mod whitened;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;

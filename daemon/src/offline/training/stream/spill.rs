@@ -81,11 +81,6 @@ impl Spill {
             .context("cannot trim the spill file")
     }
 
-    /// Bytes per record.
-    pub(super) fn record_bytes(&self) -> usize {
-        self.record_bytes
-    }
-
     /// Records written.
     pub(super) fn records(&self) -> usize {
         self.records
