@@ -57,6 +57,10 @@ pub enum FitError {
         /// Channels offered.
         channels: usize,
     },
+    /// The covariance's eigendecomposition did not converge (a covariance of finite values
+    /// does not do this).
+    #[error("the covariance's eigendecomposition did not converge")]
+    Eigendecomposition,
     /// A fixed component count of zero.
     #[error("component count must be at least 1, got 0")]
     ZeroComponents,

@@ -20,8 +20,7 @@ pub struct Whitener {
     pub dead_channels: Vec<usize>,
     /// The other channels, ascending: rows of `basis`.
     pub live_channels: Vec<usize>,
-    /// Eigenvalues of the live covariance, largest first, negatives clamped to 0; the first `m`
-    /// are the Rayleigh quotients of the kept axes.
+    /// Eigenvalues of the live covariance, largest first, negatives clamped to 0.
     pub eigenvalues: Vec<f64>,
     /// Numerical rank of the covariance.
     pub rank: usize,
@@ -111,7 +110,7 @@ impl Whitener {
     pub(crate) fn from_stats(stats: Stats, components: Components) -> Result<Self, FitError> {
         let channels = stats.mean.len();
         let (live, dead, cov) = classify_channels(channels, &stats.seen, stats.cov)?;
-        let mut eigenvalues = eigen::sorted_eigenvalues(&cov);
+        let (eigenvalues, axes) = eigen::decompose(&cov)?;
         let lmax = eigenvalues.first().copied().unwrap_or(0.0);
         let rank = eigenvalues
             .iter()
@@ -120,10 +119,8 @@ impl Whitener {
         let m = choose_m(components, &eigenvalues, rank, stats.frames_used)?;
         let total: f64 = eigenvalues.iter().sum();
         let variance_kept = eigenvalues[..m].iter().sum::<f64>() / total;
-        let (leading, mut basis) = eigen::leading(&cov, &eigenvalues, m);
+        let mut basis = axes.columns(0, m).into_owned();
         sign_axes(&mut basis);
-        // The Rayleigh quotients of the kept axes scale them to exactly unit variance.
-        eigenvalues[..m].copy_from_slice(&leading);
         let mut rows = basis.transpose();
         for (i, mut row) in rows.row_iter_mut().enumerate() {
             row /= eigenvalues[i].sqrt();
