@@ -1,18 +1,24 @@
 //! The bounded sample streaming training learns the head and the glitch limits from: whole
 //! stretches of [`SEGMENT_FRAMES`] consecutive frames, evenly spread over the session, at most
 //! [`super::SAMPLE_FRAMES`] in all, drawn while the takes stream past without knowing the
-//! session's length in advance.
+//! session's exact length in advance.
 //!
 //! Every segment gets a running index; segments whose index is a multiple of the stride are
 //! kept. When the kept frames pass the budget the stride doubles and every other kept segment
-//! is dropped, so the sample stays evenly spread and between half the budget and the budget.
-//! A session within the budget is sampled whole: its takes come back exactly as they were.
+//! is dropped, so the sample stays evenly spread and within the budget. Doubling alone leaves
+//! anywhere between half the budget and all of it, depending on the session's length (19,000
+//! frames at 10 minutes, 13,500 at 1 and 4 hours), so a session guessed (from its files'
+//! sizes) to be well over the budget starts at the stride that keeps about [`TARGET_SHARE`]
+//! of it. A session within the budget is sampled whole: its takes come back exactly as they
+//! were.
 
 use crate::offline::ModelFrames;
 
 /// Frames per sampled stretch: 2 s at 120 Hz, long enough for the speeds and second
 /// differences the glitch limits and the head search read.
 pub const SEGMENT_FRAMES: usize = 240;
+/// Share of the budget a long session's sample aims at.
+pub const TARGET_SHARE: f64 = 0.75;
 
 /// A stretch of one take.
 #[derive(Debug)]
@@ -34,11 +40,21 @@ pub(super) struct Sampler {
 }
 
 impl Sampler {
-    /// An empty sample of at most `budget` frames.
-    pub(super) fn new(budget: usize) -> Self {
+    /// An empty sample of at most `budget` frames of a session of about `expected` frames.
+    /// Only a guess over twice the budget sets the first stride, so a short session whose
+    /// guess was high is still sampled whole.
+    pub(super) fn new(budget: usize, expected: f64) -> Self {
+        let budget = budget.max(SEGMENT_FRAMES);
+        let segments = expected / SEGMENT_FRAMES as f64;
+        let target = (TARGET_SHARE * budget as f64 / SEGMENT_FRAMES as f64).max(1.0);
+        let stride = if expected > 2.0 * budget as f64 {
+            (segments / target).floor().max(1.0) as usize
+        } else {
+            1
+        };
         Self {
-            budget: budget.max(SEGMENT_FRAMES),
-            stride: 1,
+            budget,
+            stride,
             next: 0,
             kept_frames: 0,
             kept: Vec::new(),
@@ -153,7 +169,7 @@ mod tests {
 
     #[test]
     fn a_session_within_the_budget_comes_back_whole() {
-        let mut s = Sampler::new(10_000);
+        let mut s = Sampler::new(10_000, 1_537.0);
         let takes = [take(500, 0.0), take(37, 1e5), take(1_000, 2e5)];
         for (i, t) in takes.iter().enumerate() {
             push(&mut s, i, t);
@@ -165,9 +181,37 @@ mod tests {
         }
     }
 
+    /// 200 takes of 1,000 frames sampled with a budget of 5,000, the session guessed to have
+    /// `expected` frames: the first stride and the frames kept.
+    fn long_session(expected: f64) -> (usize, usize) {
+        let mut s = Sampler::new(5_000, expected);
+        let first = s.stride;
+        for i in 0..200 {
+            push(&mut s, i, &take(1_000, i as f32 * 1e4));
+        }
+        let frames = s.finish(&[0]).iter().map(ModelFrames::frames).sum();
+        (first, frames)
+    }
+
+    #[test]
+    fn a_guessed_length_keeps_about_the_target_share() {
+        // 200,000 frames guessed: 833 segments of 240 frames, 15.6 of them aimed at. (The
+        // takes' last segments are 40 frames: there are 1,000 segments of 200 on average.)
+        let (stride, guessed) = long_session(200_000.0);
+        assert_eq!(stride, 53);
+        assert!((3_000..=4_500).contains(&guessed), "{guessed}");
+        // Doubling alone lands where the stride last doubled: here at the bottom.
+        let (stride, doubled) = long_session(0.0);
+        assert_eq!(stride, 1);
+        assert!(doubled < guessed, "{doubled} vs {guessed}");
+        // A guess 4x short still keeps the budget by doubling.
+        let (_, short_guess) = long_session(50_000.0);
+        assert!((2_500..=5_000).contains(&short_guess), "{short_guess}");
+    }
+
     #[test]
     fn a_long_session_is_sampled_evenly_within_the_budget() {
-        let mut s = Sampler::new(5_000);
+        let mut s = Sampler::new(5_000, 0.0);
         for i in 0..400 {
             push(&mut s, i, &take(1_000, i as f32 * 1e4));
         }

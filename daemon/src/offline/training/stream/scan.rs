@@ -93,7 +93,7 @@ pub(super) fn scan(
     let hold = likely_frames <= 2.0 * hold_frames as f64;
     drop(first);
     let mut counts = MissingCounts::new(first_labels.clone());
-    let mut sampler = Sampler::new(sample_frames);
+    let mut sampler = Sampler::new(sample_frames, likely_frames);
     let mut scan = Scan {
         rate_hz,
         labels: Vec::new(),
