@@ -108,6 +108,21 @@ def report(path):
             print(f"{name} per frame, {sizes[0]} / {sizes[-1]}, run by run: "
                   f"{' '.join(f'{r:.2f}' for r in ratios)} "
                   f"(median {statistics.median(ratios):.2f})")
+        # FastICA's iteration count is the data's (the synthetic sessions' 20 components are
+        # not stable across restarts, and a last-digit change moves it by 10 either way). The
+        # same ratio with the smaller run's refinement scaled to the larger run's count.
+        pairs = [(a, b) for a, b in zip(small, large)
+                 if len(a) > 6 and len(b) > 6 and a[6] > 0 and a[5] > 0]
+        if pairs:
+            def at_iterations(run, iterations):
+                return run[0] - run[6] + run[6] * iterations / run[5]
+            ratios = [(at_iterations(a, b[5]) / a[2]) / (b[0] / b[2]) for a, b in pairs]
+            print(f"wall time per frame at the {sizes[-1]} run's FastICA iterations, "
+                  f"{sizes[0]} / {sizes[-1]}, run by run: "
+                  f"{' '.join(f'{r:.2f}' for r in ratios)} "
+                  f"(median {statistics.median(ratios):.2f}; refinement "
+                  f"{statistics.median(a[6] for a, _ in pairs):.2f} s for {int(pairs[0][0][5])} "
+                  f"iterations against {int(pairs[0][1][5])})")
     for size, r in one.items():
         two = statistics.median(x[0] for x in train[size])
         print(f"{size} on one thread: {r[0]:.2f} s; on all cores {two:.2f} s ({r[0] / two:.2f}x speed-up)")
