@@ -189,8 +189,9 @@ fn fit(sample: &Sample, group: &[usize], template: &[[f64; 3]], f: usize) -> Opt
 
 /// Mean head-coordinate position of each other marker.
 fn head_means(sample: &Sample, fits: &[(usize, Fitted)], others: &[usize]) -> Vec<Vector3<f64>> {
+    // Markers at once on the current rayon pool, collected in order.
     others
-        .iter()
+        .par_iter()
         .filter_map(|&m| {
             let (mut sum, mut count) = (Vector3::zeros(), 0usize);
             for (f, fitted) in fits {
@@ -275,8 +276,9 @@ fn pose_params(p: &Pose) -> SVector<f64, 6> {
 /// the pose parameters.
 fn leakage(sample: &Sample, fits: &[(usize, Fitted)], others: &[usize]) -> f64 {
     let params: Vec<SVector<f64, 6>> = fits.iter().map(|(_, f)| pose_params(&f.pose)).collect();
+    // Markers at once on the current rayon pool, collected in order.
     let mut shares: Vec<f64> = others
-        .iter()
+        .par_iter()
         .filter_map(|&m| {
             let rows: Vec<(SVector<f64, 7>, Vector3<f64>)> = fits
                 .iter()

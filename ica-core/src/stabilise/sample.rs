@@ -89,20 +89,33 @@ impl Sample {
 
     /// Marks samples whose step to a neighbour is a glitch (see [`GLITCH_FACTOR`]).
     fn mask_glitches(&mut self) {
-        let mut steps = Vec::new();
-        for s in 0..self.frames() {
-            let [b, a, n] = self.triple(s);
-            for m in 0..self.markers {
-                steps.extend(self.step(b, a, m));
-                steps.extend(self.step(a, n, m));
-            }
-        }
+        use rayon::prelude::*;
+        // Both steps of every triple and marker (NaN where a sample is missing), measured once,
+        // triples at once on the current rayon pool and collected in order.
+        let markers = self.markers;
+        let this = &*self;
+        let both: Vec<[f64; 2]> = (0..self.frames())
+            .into_par_iter()
+            .flat_map_iter(|s| {
+                let [b, a, n] = this.triple(s);
+                (0..markers).map(move |m| {
+                    let step = |x: usize, y: usize| this.step(x, y, m).unwrap_or(f64::NAN);
+                    [step(b, a), step(a, n)]
+                })
+            })
+            .collect();
+        let mut steps: Vec<f64> = both
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|v| !v.is_nan())
+            .collect();
         let limit = (GLITCH_FACTOR * quantile(&mut steps, 0.999)).max(MIN_GLITCH_STEP_MM);
         for s in 0..self.frames() {
             let [b, a, n] = self.triple(s);
             for m in 0..self.markers {
-                let jump = |x: Option<f64>| x.is_some_and(|v| v > limit);
-                if jump(self.step(b, a, m)) || jump(self.step(a, n, m)) {
+                // NaN (missing) is never above the limit.
+                if both[s * markers + m].iter().any(|&v| v > limit) {
                     for g in [b, a, n] {
                         let i = g * self.markers + m;
                         self.glitches += usize::from(self.present[i]);
