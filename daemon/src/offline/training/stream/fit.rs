@@ -1,7 +1,8 @@
 //! Driving [`StreamFit`] on the pool: the whitening pass over prepared frames (both halves of
-//! each batch whitened at once, pushed in frame order), the whitened frames spilled as `f32`,
-//! and every FastICA iteration one pass over the spill with both halves of each chunk
-//! accumulated at once and merged in order (bit-identical whatever the thread count).
+//! each batch whitened at once, pushed in frame order), the whitened frames kept as `f32` (the
+//! first 16 MiB in memory, the rest spilled: [`super::whitened`]), and every FastICA iteration
+//! one pass over them with both halves of each chunk accumulated at once and merged in order
+//! (bit-identical whatever the thread count).
 
 use anyhow::{Context, Result};
 use ica_core::fit::{FastIcaParams, FitData, FitOutput, Pass, StreamFit};
