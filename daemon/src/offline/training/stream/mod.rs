@@ -15,8 +15,9 @@
 //!
 //! Memory: one batch of takes ([`BATCH_FRAMES`] frames, or one take if longer), the sample,
 //! the covariance and the model, the quality report's bounded samples and at most 16 MiB of
-//! whitened frames; never a copy of the session. Both halves of every batch and chunk run at once on the pool, and partial sums are
-//! merged in a fixed order, so the model is the same with one thread or several.
+//! whitened frames; never a copy of the session. Both halves of every batch and chunk run at
+//! once on the pool, and partial sums are merged in a fixed order, so the model is the same
+//! with one thread or several.
 
 mod collect;
 mod fit;

@@ -91,9 +91,17 @@ pub(super) fn scan(
         first.n_frames() as f64 * (rate_hz / first.rate_hz) * sizes.iter().sum::<u64>() as f64
             / sizes.first().copied().unwrap_or(1).max(1) as f64;
     let hold = likely_frames <= 2.0 * hold_frames as f64;
+    // The sampler's first stride trusts the guess only where the files are alike: a C3D first
+    // take among CSV or TRC ones (several times the bytes per frame) would make the guess, and
+    // the stride, several times too large, and the sample that much too small. Otherwise the
+    // stride only doubles, which keeps at least half the budget.
+    let alike = paths
+        .iter()
+        .all(|p| p.extension() == first_path.extension());
+    let sample_guess = if alike { likely_frames } else { 0.0 };
     drop(first);
     let mut counts = MissingCounts::new(first_labels.clone());
-    let mut sampler = Sampler::new(sample_frames, likely_frames);
+    let mut sampler = Sampler::new(sample_frames, sample_guess);
     let mut scan = Scan {
         rate_hz,
         labels: Vec::new(),
