@@ -24,7 +24,12 @@ pub fn for_stderr(command: &'static str) -> Box<dyn Progress> {
         .and_then(|v| v.parse::<f64>().ok())
         .filter(|v| v.is_finite() && *v >= 0.0)
         .map_or(LINE_INTERVAL, Duration::from_secs_f64);
-    Box::new(Lines::new(command, std::io::stderr(), interval))
+    // Line-buffered: stderr is not, and a line's formatting writes it piece by piece.
+    Box::new(Lines::new(
+        command,
+        std::io::LineWriter::new(std::io::stderr()),
+        interval,
+    ))
 }
 
 /// Ends the display of work that returned `result`: cleared when it succeeded, stopped

@@ -1,7 +1,7 @@
 //! Centring and PCA whitening (section 3.2 of the paper: `x = E{x} + P A u`).
 //!
 //! The covariance of the complete frames is accumulated in f64 (blocked gemm, upper triangle
-//! only), decomposed with nalgebra's `SymmetricEigen`, and the principal axes are sorted by
+//! only), decomposed by faer's symmetric eigensolver, and the principal axes are sorted by
 //! variance. The first `m` axes, each scaled to unit variance, whiten the data; FastICA then
 //! only has to find a rotation of them.
 //!
