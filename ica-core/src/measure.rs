@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use crate::model::IcaModel;
 use crate::robust::{mad, median};
+use crate::whiten::Whitener;
 
 /// Training frames as the model saw them: positions (frames x channels, head coordinates
 /// when stabilised), missing flags per channel, and each take's frame range.
@@ -45,16 +46,58 @@ impl TrainingFrames<'_> {
 /// matrix-vector products per frame.
 const RESIDUAL_BLOCK: usize = 512;
 
-/// The residuals `(x − mean) − M W (x − mean)` of the frames in the columns of `x` (complete
-/// frames, or means of complete frames: the residual is linear in `x`), in place.
-fn residual_columns(model: &IcaModel, x: &mut DMatrix<f64>) {
+/// What a residual is measured against: the part of a frame a model reconstructs.
+///
+/// An [`IcaModel`] reconstructs `mean + M W (x − mean)`. The [`Whitener`] it was fitted
+/// through spans the same subspace (`M W` projects onto the kept principal axes whatever the
+/// rotation FastICA finds), so a streaming caller can measure the residual from the whitener
+/// while FastICA runs; the two agree to rounding.
+pub trait Reconstruction: Sync {
+    /// Channels per frame.
+    fn channels(&self) -> usize;
+    /// Replaces each column of `x` (a frame, or a mean of frames: the residual is linear) by
+    /// its residual.
+    fn residual_columns(&self, x: &mut DMatrix<f64>);
+}
+
+fn centre_columns(x: &mut DMatrix<f64>, mean: &[f64]) {
     for mut column in x.column_iter_mut() {
-        for (v, mu) in column.iter_mut().zip(model.mean()) {
+        for (v, mu) in column.iter_mut().zip(mean) {
             *v -= mu;
         }
     }
-    let u = model.unmixing() * &*x;
-    x.gemm(-1.0, model.mixing(), &u, 1.0);
+}
+
+impl Reconstruction for IcaModel {
+    fn channels(&self) -> usize {
+        IcaModel::channels(self)
+    }
+
+    /// `(x − mean) − M W (x − mean)`.
+    fn residual_columns(&self, x: &mut DMatrix<f64>) {
+        centre_columns(x, self.mean());
+        let u = self.unmixing() * &*x;
+        x.gemm(-1.0, self.mixing(), &u, 1.0);
+    }
+}
+
+impl Reconstruction for Whitener {
+    fn channels(&self) -> usize {
+        self.mean.len()
+    }
+
+    /// `(x − mean) − E Eᵀ (x − mean)` on the live channels (`E` the kept axes), `x − mean` on
+    /// the dead ones (the model's mixing has zero rows there).
+    fn residual_columns(&self, x: &mut DMatrix<f64>) {
+        centre_columns(x, &self.mean);
+        let live = x.select_rows(&self.live_channels);
+        let coefficients = self.basis.tr_mul(&live);
+        let mut residual = live;
+        residual.gemm(-1.0, &self.basis, &coefficients, 1.0);
+        for (r, &c) in self.live_channels.iter().enumerate() {
+            x.row_mut(c).copy_from(&residual.row(r));
+        }
+    }
 }
 
 /// Frames examined at most by [`residual_by_marker`] (evenly strided).
@@ -96,16 +139,19 @@ pub struct ResidualSums {
 
 impl ResidualSums {
     /// The sums over the complete frames given (`channels` values each).
-    pub fn of<'a>(model: &IcaModel, frames: impl Iterator<Item = &'a [f32]>) -> ResidualSums {
+    pub fn of<'a>(
+        model: &impl Reconstruction,
+        frames: impl Iterator<Item = &'a [f32]>,
+    ) -> ResidualSums {
         let c = model.channels();
         let mut sums = ResidualSums {
-            sq: vec![0.0; model.markers()],
+            sq: vec![0.0; c / 3],
             frames: 0,
         };
         let mut block: Vec<f64> = Vec::with_capacity(RESIDUAL_BLOCK * c);
         let mut add = |block: &mut Vec<f64>| {
             let mut r = DMatrix::from_vec(c, block.len() / c, std::mem::take(block));
-            residual_columns(model, &mut r);
+            model.residual_columns(&mut r);
             for frame in r.column_iter() {
                 for (k, s) in sums.sq.iter_mut().enumerate() {
                     *s +=
@@ -197,13 +243,16 @@ pub fn slow_residual(model: &IcaModel, data: &TrainingFrames<'_>) -> Option<(f64
 /// [`slow_residual`] from the kept blocks' mean frames (the residual is linear, so the
 /// residual of a block's mean is the block's mean residual), as a streaming caller collects
 /// them.
-pub fn slow_residual_of_means(model: &IcaModel, means: &[Vec<f64>]) -> Option<(f64, usize)> {
+pub fn slow_residual_of_means(
+    model: &impl Reconstruction,
+    means: &[Vec<f64>],
+) -> Option<(f64, usize)> {
     let c = model.channels();
     if means.len() < 8 {
         return None;
     }
     let mut r = DMatrix::from_iterator(c, means.len(), means.iter().flatten().copied());
-    residual_columns(model, &mut r);
+    model.residual_columns(&mut r);
     slow_direction(&r)
 }
 
@@ -379,6 +428,59 @@ mod tests {
                 got[k]
             );
         }
+    }
+
+    #[test]
+    fn the_whitening_measures_the_residual_of_any_model_fitted_through_it() {
+        use crate::fit::FitData;
+        use crate::whiten::{Components, Moments};
+        let mut r = numbers(5);
+        // 5 markers; channel 4 never moves while training (a dead channel).
+        let frame = |r: &mut dyn FnMut() -> f64, dead: f32| -> Vec<f32> {
+            (0..15)
+                .map(|c| if c == 4 { dead } else { (100.0 * r()) as f32 })
+                .collect()
+        };
+        let training: Vec<f32> = (0..600).flat_map(|_| frame(&mut r, 12.5)).collect();
+        let mut moments = Moments::new(15);
+        moments
+            .add_chunk(&FitData::new(&training, 15).expect("15 channels"))
+            .expect("finite");
+        let w = Whitener::from_moments(&moments, Components::Fixed(3)).expect("a whitening");
+        assert_eq!(w.dead_channels, vec![4]);
+        // A model through it, as FastICA makes one: M = E Λ^½ Rᵀ on the live rows.
+        let rotation = nalgebra::Rotation3::from_euler_angles(0.3, -1.1, 2.0);
+        let rotation = DMatrix::from_fn(3, 3, |i, j| rotation[(i, j)]);
+        let scaled = DMatrix::from_fn(14, 3, |i, j| w.basis[(i, j)] * w.eigenvalues[j].sqrt());
+        let live = scaled * rotation.transpose();
+        let mut mixing = DMatrix::zeros(15, 3);
+        for (row, &c) in w.live_channels.iter().enumerate() {
+            mixing.row_mut(c).copy_from(&live.row(row));
+        }
+        let model = IcaModel::new(labels(5), 120.0, w.mean.clone(), mixing, report(15, 3))
+            .expect("valid parts");
+        // Other frames, the dead channel moving too.
+        let frames: Vec<Vec<f32>> = (0..700)
+            .map(|i| frame(&mut r, 12.5 + (i % 7) as f32))
+            .collect();
+        let by_model = residual_by_marker_of(&model, frames.iter().map(Vec::as_slice));
+        let by_whitening = ResidualSums::of(&w, frames.iter().map(Vec::as_slice)).rms();
+        for (k, (a, b)) in by_model.iter().zip(&by_whitening).enumerate() {
+            assert!(*a > 1.0, "marker {k}: the residual is not trivial");
+            assert!((a - b).abs() <= 1e-9 * a, "marker {k}: {a} vs {b}");
+        }
+        let means: Vec<Vec<f64>> = frames
+            .chunks(50)
+            .map(|block| {
+                (0..15)
+                    .map(|c| block.iter().map(|f| f64::from(f[c])).sum::<f64>() / 50.0)
+                    .collect()
+            })
+            .collect();
+        let (a, at_a) = slow_residual_of_means(&model, &means).expect("14 blocks");
+        let (b, at_b) = slow_residual_of_means(&w, &means).expect("14 blocks");
+        assert_eq!(at_a, at_b);
+        assert!((a - b).abs() <= 1e-9 * a, "slow residual {a} vs {b}");
     }
 
     #[test]

@@ -6,7 +6,7 @@
 
 use anyhow::{Context, Result};
 use ica_core::fit::{FastIcaParams, FitData, FitOutput, Pass, StreamFit};
-use ica_core::whiten::Moments;
+use ica_core::whiten::{Moments, Whitener};
 use rayon::ThreadPool;
 
 use super::whitened::{Whitened, HELD_BYTES};
@@ -21,7 +21,12 @@ pub(super) type FrameBatch<'a> = dyn FnMut(&[f32], &[bool]) -> Result<()> + 'a;
 /// Calls its argument with every prepared frame, in batches.
 pub(super) type WhitenSource<'a> = dyn FnMut(&mut FrameBatch<'_>) -> Result<()> + 'a;
 
-/// Fits `params` to the frames `source` gives, whose statistics are `moments`.
+/// Work that needs the fitted whitening only: run on the pool during the whitening pass and the
+/// restarts, which leave part of it idle.
+pub(super) type Alongside<'a> = Box<dyn FnOnce(&Whitener) + Send + 'a>;
+
+/// Fits `params` to the frames `source` gives, whose statistics are `moments`; runs
+/// `alongside` once the whitening is fitted.
 ///
 /// # Errors
 /// What the fit refuses (see [`ica_core::FitError`]), reading the takes, or the spill file.
@@ -30,12 +35,17 @@ pub(super) fn fit(
     moments: Moments,
     frames: usize,
     source: &mut WhitenSource<'_>,
+    alongside: Alongside<'_>,
     pool: &ThreadPool,
     progress: &mut dyn Progress,
 ) -> Result<FitOutput> {
     let mut fit = StreamFit::new(params, moments.channels()).context("training failed")?;
     fit.handle_moments(moments).context("training failed")?;
-    let mut store = whiten_pass(&mut fit, params, frames, source, pool, progress)?;
+    let whitener = fit.whitener().context("whitening is fitted")?.clone();
+    let mut store = pool.in_place_scope(|s| {
+        s.spawn(|_| alongside(&whitener));
+        whiten_pass(&mut fit, &whitener, params, frames, source, pool, progress)
+    })?;
     loop {
         match fit.poll_pass() {
             Pass::Update => {
@@ -80,6 +90,7 @@ pub(super) fn fit(
 /// subsample; then the restarts.
 fn whiten_pass(
     fit: &mut StreamFit,
+    whitener: &Whitener,
     params: &FastIcaParams,
     frames: usize,
     source: &mut WhitenSource<'_>,
@@ -87,7 +98,6 @@ fn whiten_pass(
     progress: &mut dyn Progress,
 ) -> Result<Whitened> {
     progress.step("whitening", "frames", Some(frames as u64));
-    let whitener = fit.whitener().context("whitening is fitted")?.clone();
     let (c, m) = (whitener.channels(), whitener.components());
     let mut sub = fit.subsample()?;
     let mut store = Whitened::new(m, CHUNK_FRAMES, HELD_BYTES)?;

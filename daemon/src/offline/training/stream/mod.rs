@@ -32,7 +32,9 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use ica_core::measure::{noise_of_differences, slow_residual_of_means, ResidualSums};
+use ica_core::measure::{
+    noise_of_differences, slow_residual_of_means, Reconstruction, ResidualSums,
+};
 use ica_core::model::IcaModel;
 use rayon::ThreadPool;
 
@@ -153,7 +155,22 @@ fn streamed(
             each(values, mask)
         })
     };
-    let fit = fit::fit(&params, filled.moments, total, &mut source, pool, progress)?;
+    // The report's residuals need only the subspace the model will span: measured from the
+    // whitening while the pool has room.
+    let (frames, means) = (&collected.residual_frames, &collected.slow_means);
+    let mut residuals = None;
+    let alongside: fit::Alongside<'_> = Box::new(|whitener| {
+        residuals = Some(residual_measures(whitener, frames, means, c, pool));
+    });
+    let fit = fit::fit(
+        &params,
+        filled.moments,
+        total,
+        &mut source,
+        alongside,
+        pool,
+        progress,
+    )?;
     progress.finish();
     let mut model = IcaModel::new(
         scanned.labels.clone(),
@@ -168,22 +185,8 @@ fn streamed(
     if let Some(residuals) = head_residuals {
         head.residual_mm = residuals;
     }
-    // The residual's two halves and the slow residual at once; the halves are fixed, so the
-    // sums do not depend on the thread count.
-    let c = collected.channels;
-    let frames = &collected.residual_frames;
-    let (left, right) = frames.split_at(frames.len() / c / 2 * c);
-    let ((mut sums, right), slow_residual) = pool.join(
-        || {
-            pool.join(
-                || ResidualSums::of(&model, left.chunks_exact(c)),
-                || ResidualSums::of(&model, right.chunks_exact(c)),
-            )
-        },
-        || slow_residual_of_means(&model, &collected.slow_means),
-    );
-    sums.add(&right);
-    let residual_by_marker_mm = sums.rms();
+    let (residual_by_marker_mm, slow_residual) =
+        residuals.context("the residuals were measured alongside the fit")?;
     let measures = Measures {
         residual_by_marker_mm,
         slow_residual,
@@ -219,6 +222,32 @@ fn streamed(
         noise_mm,
         capped_at_noise,
     })
+}
+
+/// Each marker's RMS residual over the residual frames (`channels` values each), and the slow
+/// residual of the blocks' means, against `model`'s reconstruction. The residual's two halves
+/// and the slow residual run at once; the halves are fixed, so the sums do not depend on the
+/// thread count.
+fn residual_measures(
+    model: &impl Reconstruction,
+    frames: &[f32],
+    means: &[Vec<f64>],
+    channels: usize,
+    pool: &ThreadPool,
+) -> (Vec<f64>, Option<(f64, usize)>) {
+    let c = channels;
+    let (left, right) = frames.split_at(frames.len() / c / 2 * c);
+    let ((mut sums, right), slow_residual) = pool.join(
+        || {
+            pool.join(
+                || ResidualSums::of(model, left.chunks_exact(c)),
+                || ResidualSums::of(model, right.chunks_exact(c)),
+            )
+        },
+        || slow_residual_of_means(model, means),
+    );
+    sums.add(&right);
+    (sums.rms(), slow_residual)
 }
 
 /// A batch prepared and not yet collected: its index and its takes.
