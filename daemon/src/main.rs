@@ -6,5 +6,18 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
-    daemon::commands::main_with(daemon::cli::Cli::parse())
+    match daemon::cli::Cli::try_parse() {
+        Ok(cli) => daemon::commands::main_with(cli),
+        // --help and --version, and the help a bare `emoshift` gets.
+        Err(e)
+            if !e.use_stderr()
+                || e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+        {
+            e.exit()
+        }
+        Err(e) => {
+            eprintln!("emoshift: error: {}", daemon::cli::one_line(&e));
+            ExitCode::from(2)
+        }
+    }
 }

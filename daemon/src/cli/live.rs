@@ -27,7 +27,7 @@ pub struct ServeArgs {
     #[arg(long, value_name = "HOST:PORT[:PROFILE]")]
     pub send: Vec<String>,
     /// Low-pass window of the emotion edit, seconds [default: 1].
-    #[arg(long)]
+    #[arg(long, value_parser = super::values::non_negative_f32)]
     pub lowpass: Option<f32>,
     /// Serve the monitor page here (a browser shows the faces, the emotion control and the
     /// health); loopback unless told otherwise. Beyond loopback it asks for a token.
@@ -86,7 +86,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 2)]
     pub clients: usize,
     /// Seconds of each timed run.
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, default_value_t = 3.0, value_parser = super::values::positive)]
     pub seconds: f64,
     /// The daemon's `poll_window_us` (0: the processing thread always parks).
     #[arg(long, default_value_t = crate::serve::config::DEFAULT_POLL_WINDOW_US)]
@@ -125,7 +125,7 @@ pub struct RecordArgs {
     #[arg(long, value_name = "N", conflicts_with = "seconds")]
     pub frames: Option<u64>,
     /// Stop after this many seconds of capture.
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", value_parser = super::values::positive)]
     pub seconds: Option<f64>,
     /// The stream to record: a NatNet markerset (asset) name, or `IP:PORT/LAYOUT` of an OSC
     /// source [default: the first stream that arrives].
@@ -142,7 +142,7 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "HOST:PORT")]
     pub to: String,
     /// Playback speed: 2 sends twice as fast (capture times stay in take time).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = super::values::positive)]
     pub speed: f64,
     /// After the last frame start again from the first, until Ctrl-C; frame numbers keep
     /// increasing.

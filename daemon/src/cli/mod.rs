@@ -4,12 +4,27 @@ use clap::{Parser, Subcommand};
 
 mod live;
 mod offline;
+mod values;
 
 pub use live::{BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, WireFormat};
 pub use offline::{
     AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InspectArgs, KeyValue, ProjectArgs, SynthArgs,
     TrainArgs,
 };
+
+/// A command-line error on one line, as every other failure is: clap's message with its
+/// indented details joined on, then where to look.
+pub fn one_line(error: &clap::Error) -> String {
+    let text = error.render().to_string();
+    let message: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.trim().is_empty())
+        .map(str::trim)
+        .collect();
+    let message = message.join(" ");
+    let message = message.strip_prefix("error: ").unwrap_or(&message);
+    format!("{message} (see --help)")
+}
 
 /// emoshift: edit the emotion of facial motion capture, offline and live.
 #[derive(Debug, Parser)]

@@ -31,7 +31,7 @@ pub struct SynthArgs {
     #[arg(long = "point", value_name = "NAME=X[,Y[,Z]]", value_delimiter = ';')]
     pub points: Vec<replay::synth::EmotionPoint>,
     /// Frame rate in Hz.
-    #[arg(long, default_value_t = 120.0)]
+    #[arg(long, default_value_t = 120.0, value_parser = super::values::positive)]
     pub rate: f64,
     /// Add small rigid head motion.
     #[arg(long)]
@@ -48,7 +48,7 @@ pub struct SynthArgs {
     pub rigid: replay::synth::RigidMarkers,
     /// Move each face marker at random by up to this many mm (and the face's width and height
     /// by up to 8 %), so the face is not the default one.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = super::values::non_negative)]
     pub placement_jitter: f64,
     /// File format of the takes: c3d, trc or csv.
     #[arg(long, default_value = "c3d")]
@@ -107,13 +107,18 @@ pub struct TrainArgs {
     #[arg(long, default_value_t = ica_core::fit::DEFAULT_MAX_ITER)]
     pub max_iter: usize,
     /// Convergence tolerance.
-    #[arg(long, default_value_t = ica_core::fit::DEFAULT_TOL)]
+    #[arg(long, default_value_t = ica_core::fit::DEFAULT_TOL, value_parser = super::values::positive)]
     pub tol: f64,
-    /// Model rate in Hz; takes at other rates are resampled (default: the first take's rate).
-    #[arg(long)]
+    /// Model rate in Hz; takes at other rates are resampled (default: the manifest's
+    /// `rate_hz`, else the first take's rate).
+    #[arg(long, value_parser = super::values::positive)]
     pub rate: Option<f64>,
     /// Leave out markers missing in more than this share of the frames.
-    #[arg(long, default_value_t = crate::offline::training::DEFAULT_MAX_MISSING)]
+    #[arg(
+        long,
+        default_value_t = crate::offline::training::DEFAULT_MAX_MISSING,
+        value_parser = super::values::share
+    )]
     pub max_missing: f64,
     /// Glitch speed limit: auto, off, or mm/s. Faster moves are treated as missing.
     #[arg(long, default_value = "auto")]
@@ -192,11 +197,21 @@ pub struct EditArgs {
     #[arg(long, value_name = "NAME")]
     pub to_emotion: Option<String>,
     /// How far to move towards --to-emotion: 0 keeps the take, 1 reaches the level.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        requires = "to_emotion",
+        value_parser = super::values::finite
+    )]
     pub amount: f64,
     /// With --to-emotion: edit as the live daemon does, from a causal low-pass of the emotion
     /// component over this many seconds, instead of the take's mean (same output as `serve`).
-    #[arg(long, value_name = "SECONDS", requires = "to_emotion")]
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        requires = "to_emotion",
+        value_parser = super::values::non_negative
+    )]
     pub lowpass: Option<f64>,
     /// Copy & Replace: take the emotion series of another take (DTW-aligned to this one; both
     /// takes are held whole in memory).

@@ -69,9 +69,13 @@ fn resolve(to: &str) -> Result<SocketAddr> {
     let mut addrs = to
         .to_socket_addrs()
         .map_err(|e| UsageError(format!("--to {to:?}: {e} (expected HOST:PORT)")))?;
-    addrs
+    let addr = addrs
         .next()
-        .ok_or_else(|| UsageError(format!("--to {to:?} resolves to no address")).into())
+        .ok_or_else(|| UsageError(format!("--to {to:?} resolves to no address")))?;
+    if addr.port() == 0 {
+        return Err(UsageError(format!("--to {to:?}: port 0 is not a destination")).into());
+    }
+    Ok(addr)
 }
 
 /// The local address to bind for sending to `to`: loopback stays on loopback.
