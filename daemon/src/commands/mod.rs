@@ -39,6 +39,14 @@ pub fn main_with(cli: Cli) -> std::process::ExitCode {
     }
 }
 
+/// `1 take`, `2 takes`: a count and its noun.
+pub(crate) fn count(n: usize, noun: &str) -> String {
+    match n {
+        1 => format!("1 {noun}"),
+        _ => format!("{n} {noun}s"),
+    }
+}
+
 /// Runs the parsed command line.
 ///
 /// # Errors

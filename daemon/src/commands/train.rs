@@ -120,7 +120,11 @@ pub(crate) fn options_with_regions(regions: Regions) -> TrainOptions {
 }
 
 pub(crate) fn run(args: &TrainArgs) -> Result<()> {
-    let options = options(args)?;
+    let mut options = options(args)?;
+    if let (None, Some(manifest)) = (args.rate, args.manifest.as_deref()) {
+        // A manifest declares its session's rate: the model's, unless --rate says otherwise.
+        options.prep.rate_hz = Some(offline::load_session(manifest)?.rate_hz);
+    }
     let paths = offline::input_paths(args.manifest.as_deref(), &args.files)?;
     let mut inputs: Vec<&Path> = paths.iter().map(PathBuf::as_path).collect();
     inputs.extend(args.manifest.as_deref());
@@ -188,9 +192,9 @@ fn save_and_print(
     print_summary(&model, takes, started.elapsed().as_secs_f64())?;
     if capped_at_noise {
         crate::out!(
-            "the default {:.0} % of the variance would reach into noise ({noise_mm:.3} mm per coordinate): kept the {} components above the noise floor",
+            "the default {:.0} % of the variance would reach into noise ({noise_mm:.3} mm per coordinate): kept the {} above the noise floor",
             100.0 * DEFAULT_VARIANCE_TARGET,
-            model.components()
+            super::count(model.components(), "component")
         );
     }
     super::inspect::print_quality(model.quality())?;
@@ -199,6 +203,15 @@ fn save_and_print(
 }
 
 fn print_preparation(data: &PrepReport) -> Result<()> {
+    for note in data.label_notes.iter().take(5) {
+        crate::out!("warning: {note}");
+    }
+    if data.label_notes.len() > 5 {
+        crate::out!(
+            "warning: and {} more takes whose markers differ from the first take's",
+            data.label_notes.len() - 5
+        );
+    }
     for (file, from, to) in &data.resampled {
         crate::out!("resampled {file} from {from} Hz to {to} Hz");
     }
@@ -257,7 +270,8 @@ fn print_summary(model: &IcaModel, takes: usize, seconds: f64) -> Result<()> {
     let r = model.report();
     let best = &r.restarts[r.best_restart];
     crate::out!(
-        "trained on {takes} takes: used {} of {} frames, {} markers, {} dead channels",
+        "trained on {}: used {} of {} frames, {} markers, {} dead channels",
+        super::count(takes, "take"),
         r.frames_used,
         r.frames_total,
         model.markers(),

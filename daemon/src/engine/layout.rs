@@ -18,6 +18,56 @@ pub enum LayoutError {
     },
 }
 
+/// How a take's labels differ from a model's ([`LabelMap::differences`]).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct LabelDifferences {
+    /// Model markers the take lacks.
+    pub absent: Vec<String>,
+    /// Take markers the model does not know.
+    pub extra: Vec<String>,
+    /// Markers of the model.
+    pub model_markers: usize,
+}
+
+impl LabelDifferences {
+    /// Nothing differs.
+    pub fn is_empty(&self) -> bool {
+        self.absent.is_empty() && self.extra.is_empty()
+    }
+
+    /// One line: `lacks 1 of the <model>'s 38 markers (a); has 1 marker the <model> does not
+    /// have (b)`, naming at most five of each; `None` when nothing differs.
+    pub fn describe(&self, model: &str) -> Option<String> {
+        let mut parts = Vec::new();
+        if !self.absent.is_empty() {
+            parts.push(format!(
+                "lacks {} of the {model}'s {} markers ({})",
+                self.absent.len(),
+                self.model_markers,
+                some_of(&self.absent)
+            ));
+        }
+        if !self.extra.is_empty() {
+            let n = self.extra.len();
+            parts.push(format!(
+                "has {n} marker{} the {model} does not have ({})",
+                if n == 1 { "" } else { "s" },
+                some_of(&self.extra)
+            ));
+        }
+        (!parts.is_empty()).then(|| parts.join("; "))
+    }
+}
+
+/// The first five names, then how many more.
+fn some_of(names: &[String]) -> String {
+    let shown = names.iter().take(5).cloned().collect::<Vec<_>>().join(", ");
+    match names.len().saturating_sub(5) {
+        0 => shown,
+        more => format!("{shown} and {more} more"),
+    }
+}
+
 /// For each model marker, the take marker with the same label, if any.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LabelMap {
@@ -59,6 +109,17 @@ impl LabelMap {
     /// Model markers the take does not have.
     pub fn absent(&self) -> impl Iterator<Item = usize> + '_ {
         (0..self.model_to_take.len()).filter(|&i| self.model_to_take[i].is_none())
+    }
+
+    /// The model markers the take lacks and the take markers the model does not know, by
+    /// label (`model` and `take` as given to [`LabelMap::new`]): what a user should hear about
+    /// before trusting a result.
+    pub fn differences(&self, model: &[String], take: &[String]) -> LabelDifferences {
+        LabelDifferences {
+            absent: self.absent().map(|i| model[i].clone()).collect(),
+            extra: self.extra.iter().map(|&t| take[t].clone()).collect(),
+            model_markers: model.len(),
+        }
     }
 
     /// Copies one take frame into model order. Allocation-free.
@@ -163,6 +224,31 @@ mod tests {
         let (mut xyz, mut missing) = ([0.0; 9], [true; 3]);
         shifted.gather_present_into(&take4, &mut xyz, &mut missing);
         assert_eq!((xyz, missing), (take, [false; 3]));
+    }
+
+    #[test]
+    fn differences_name_the_absent_and_the_extra_markers() {
+        let model = labels(&["a", "b", "c", "d", "e", "f", "g"]);
+        let take = labels(&["b", "x", "a"]);
+        let map = LabelMap::new(&model, &take).expect("shared markers");
+        let d = map.differences(&model, &take);
+        assert_eq!(d.absent, labels(&["c", "d", "e", "f", "g"]));
+        assert_eq!(d.extra, labels(&["x"]));
+        assert_eq!(
+            d.describe("model").as_deref(),
+            Some("lacks 5 of the model's 7 markers (c, d, e, f, g); has 1 marker the model does not have (x)")
+        );
+        let take = labels(&["g", "f", "e", "d", "c", "b", "a"]);
+        let same = LabelMap::new(&model, &take).expect("the same markers");
+        assert!(same.differences(&model, &take).is_empty());
+        assert_eq!(same.differences(&model, &take).describe("model"), None);
+        let few = labels(&["a"]);
+        let one = LabelMap::new(&model, &few).expect("one shared marker");
+        let text = one.differences(&model, &few).describe("first take");
+        assert_eq!(
+            text.as_deref(),
+            Some("lacks 6 of the first take's 7 markers (b, c, d, e, f and 1 more)")
+        );
     }
 
     #[test]

@@ -103,6 +103,8 @@ pub struct PreparedData {
     pub capture: CaptureSettings,
     /// Markers left out, with the share of frames they were missing in.
     pub excluded: Vec<(String, f64)>,
+    /// One line per take whose markers differ from the first take's.
+    pub label_notes: Vec<String>,
     /// Takes resampled: file, from rate, to rate.
     pub resampled: Vec<(String, f64, f64)>,
     /// Samples dropped as glitches.
@@ -146,6 +148,7 @@ pub(crate) fn residual_summary(residuals_mm: &[f64]) -> Option<(f64, f64)> {
 /// marker with the first.
 pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedData> {
     let rate_hz = options.rate_hz.unwrap_or(takes[0].take.rate_hz);
+    let names: Vec<String> = takes.iter().map(|t| t.path.display().to_string()).collect();
     let mut resampled = Vec::new();
     let takes: Vec<replay::Take> = takes
         .iter()
@@ -158,7 +161,11 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
             }
         })
         .collect();
-    let (labels, excluded) = kept_markers(&takes, options.max_missing_share)?;
+    let KeptMarkers {
+        labels,
+        excluded,
+        label_notes,
+    } = kept_markers(&takes, &names, options.max_missing_share)?;
     let frames: Vec<ModelFrames> = takes
         .iter()
         .map(|t| {
@@ -201,6 +208,7 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         missing: marker_missing.iter().flat_map(|&m| [m, m, m]).collect(),
         capture,
         excluded,
+        label_notes,
         resampled,
         glitches,
         residuals_mm,
@@ -255,13 +263,23 @@ pub(crate) fn run_prep(
 }
 
 /// Labels kept, and the labels left out with the share of frames they were missing in.
-type KeptMarkers = (Vec<String>, Vec<(String, f64)>);
+/// The markers a model keeps, those left out, and how takes' labels differ from the first's.
+#[derive(Debug, Clone)]
+pub(crate) struct KeptMarkers {
+    /// The first take's labels minus the markers missing too often.
+    pub labels: Vec<String>,
+    /// Markers left out, with the share of frames they were missing in.
+    pub excluded: Vec<(String, f64)>,
+    /// One line per take whose markers differ from the first take's.
+    pub label_notes: Vec<String>,
+}
 
-/// The first take's labels minus the markers missing too often over all takes.
-fn kept_markers(takes: &[replay::Take], max_share: f64) -> Result<KeptMarkers> {
+/// The first take's labels minus the markers missing too often over all takes (`names`
+/// name the takes in notes).
+fn kept_markers(takes: &[replay::Take], names: &[String], max_share: f64) -> Result<KeptMarkers> {
     let mut counts = MissingCounts::new(takes[0].labels.clone());
-    for t in takes {
-        counts.add(t)?;
+    for (t, name) in takes.iter().zip(names) {
+        counts.add(t, name)?;
     }
     counts.kept(max_share)
 }
@@ -272,6 +290,7 @@ pub(crate) struct MissingCounts {
     first: Vec<String>,
     missing: Vec<usize>,
     frames: usize,
+    label_notes: Vec<String>,
 }
 
 impl MissingCounts {
@@ -281,15 +300,26 @@ impl MissingCounts {
             first,
             missing,
             frames: 0,
+            label_notes: Vec::new(),
         }
     }
 
-    /// Counts a take (at the model rate).
+    /// Counts a take (at the model rate), `name` naming it in a note if its markers differ
+    /// from the first take's: the first's it lacks are gaps to fill in all its frames, and
+    /// its own the first does not have are left out.
     ///
     /// # Errors
     /// The take shares no marker with the first.
-    pub(crate) fn add(&mut self, t: &replay::Take) -> Result<()> {
+    pub(crate) fn add(&mut self, t: &replay::Take, name: &str) -> Result<()> {
         let map = LabelMap::new(&self.first, &t.labels)?;
+        if let Some(text) = map
+            .differences(&self.first, &t.labels)
+            .describe("first take")
+        {
+            self.label_notes.push(format!(
+                "{name} {text}: those it lacks are gaps in all its frames, its others are left out"
+            ));
+        }
         let counts = t.missing_per_marker();
         for (i, src) in map.model_to_take.iter().enumerate() {
             self.missing[i] += match src {
@@ -305,7 +335,7 @@ impl MissingCounts {
     ///
     /// # Errors
     /// Every marker is missing too often.
-    pub(crate) fn kept(&self, max_share: f64) -> Result<KeptMarkers> {
+    pub(crate) fn kept(self, max_share: f64) -> Result<KeptMarkers> {
         let mut kept = Vec::new();
         let mut excluded = Vec::new();
         for (label, &gone) in self.first.iter().zip(&self.missing) {
@@ -322,6 +352,10 @@ impl MissingCounts {
                 100.0 * max_share
             );
         }
-        Ok((kept, excluded))
+        Ok(KeptMarkers {
+            labels: kept,
+            excluded,
+            label_notes: self.label_notes,
+        })
     }
 }

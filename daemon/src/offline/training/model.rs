@@ -63,6 +63,8 @@ pub struct PrepReport {
     pub capture: ica_core::model::CaptureSettings,
     /// Markers left out, with the share of frames they were missing in.
     pub excluded: Vec<(String, f64)>,
+    /// One line per take whose markers differ from the first take's.
+    pub label_notes: Vec<String>,
     /// Takes resampled: file, from rate, to rate.
     pub resampled: Vec<(String, f64, f64)>,
     /// Samples dropped as glitches.
@@ -85,6 +87,7 @@ impl PrepReport {
             rate_hz: data.rate_hz,
             capture: data.capture.clone(),
             excluded: data.excluded.clone(),
+            label_notes: data.label_notes.clone(),
             resampled: data.resampled.clone(),
             glitches: data.glitches,
             glitches_per_marker: data.glitches_per_marker.clone(),

@@ -204,6 +204,7 @@ fn streamed(
         rate_hz: scanned.rate_hz,
         capture: learned.capture,
         excluded: scanned.excluded,
+        label_notes: scanned.label_notes,
         resampled: scanned.resampled,
         glitches: collected.glitches,
         glitches_per_marker: collected.glitches_per_marker,

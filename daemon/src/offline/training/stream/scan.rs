@@ -31,6 +31,8 @@ pub(super) struct Scan {
     pub labels: Vec<String>,
     /// Markers left out, with the share of frames they were missing in.
     pub excluded: Vec<(String, f64)>,
+    /// One line per take whose markers differ from the first take's.
+    pub label_notes: Vec<String>,
     /// Takes resampled: file, from rate, to rate.
     pub resampled: Vec<(String, f64, f64)>,
     /// Frames of each take at the model rate.
@@ -106,6 +108,7 @@ pub(super) fn scan(
         rate_hz,
         labels: Vec::new(),
         excluded: Vec::new(),
+        label_notes: Vec::new(),
         resampled: Vec::new(),
         take_frames: Vec::with_capacity(paths.len()),
         sample: Vec::new(),
@@ -134,7 +137,7 @@ pub(super) fn scan(
                 }
                 let take = at_rate.as_ref().unwrap_or(&original);
                 counts
-                    .add(take)
+                    .add(take, &path.display().to_string())
                     .with_context(|| format!("{}", path.display()))?;
                 let map = LabelMap::new(&first_labels, &take.labels)
                     .with_context(|| format!("{}", path.display()))?;
@@ -164,7 +167,9 @@ pub(super) fn scan(
             Ok(())
         },
     )?;
-    let (labels, excluded) = counts.kept(prep.max_missing_share)?;
+    let kept = counts.kept(prep.max_missing_share)?;
+    let (labels, excluded) = (kept.labels, kept.excluded);
+    scan.label_notes = kept.label_notes;
     let kept: Vec<usize> = labels
         .iter()
         .map(|l| {
