@@ -97,9 +97,10 @@ fn check_edit(model: (&Path, &IcaModel), input: &Path, request: &EditRequest, fo
     replay::save(&expected, &whole).expect("whole written");
     let exact = Format::from_path(input) != Some(Format::Csv) || format == Format::Csv;
     for block in [1, 7, 100_000] {
-        let frames = streamed::edit_file(model, (input, LIMIT), request, &out, block, &mut Silent)
+        let s = streamed::edit_file(model, (input, LIMIT), request, &out, block, &mut Silent)
             .expect("streamed edit");
-        assert_eq!(frames, take.n_frames());
+        assert_eq!(s.frames, take.n_frames());
+        assert!(s.notices.is_empty(), "{:?}", s.notices);
         let what = format!("{input:?} -> {format:?} in blocks of {block}: {request:?}");
         if exact {
             assert!(read(&out) == read(&expected), "{what}");
@@ -190,6 +191,7 @@ fn streamed_projection_is_the_whole_take_projection_and_failures_leave_no_file()
             let s = streamed::project_file(&model, (&input, LIMIT), &out, block, &mut Silent)
                 .expect("projected");
             assert_eq!(s.frames, take.n_frames());
+            assert!(s.notices.is_empty(), "{:?}", s.notices);
             let got = std::fs::read_to_string(&out).expect("written");
             assert!(got == expected, "{name} in blocks of {block}");
         }
@@ -225,4 +227,40 @@ fn streamed_projection_is_the_whole_take_projection_and_failures_leave_no_file()
         .filter(|n| n.starts_with('.') || n == "u.csv" || n == "e.c3d")
         .collect();
     assert!(left.is_empty(), "{left:?}");
+}
+
+#[test]
+fn a_take_whose_markers_or_rate_differ_from_the_model_is_named_in_the_notices() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (model_path, model) = model(dir.path());
+    let mut take = damaged(dir.path(), &model).resampled(60.0);
+    let renamed = take.labels[4].clone();
+    take.labels[4] = "Renamed".into();
+    let input = save_as(dir.path(), &take, "renamed.c3d");
+    let want = [
+        format!(
+            "lacks 1 of the model's {} markers ({renamed}); has 1 marker the model does not have (Renamed)",
+            model.markers()
+        ),
+        format!("is at 60 Hz, the model at {} Hz", model.rate_hz()),
+    ];
+    let out = dir.path().join("u.csv");
+    let s =
+        streamed::project_file(&model, (&input, LIMIT), &out, 100, &mut Silent).expect("projected");
+    assert_eq!(s.notices, want);
+    let request = EditRequest {
+        translate: vec![(0, 1.0)],
+        ..EditRequest::default()
+    };
+    let edited = dir.path().join("e.c3d");
+    let s = streamed::edit_file(
+        (&model_path, &model),
+        (&input, LIMIT),
+        &request,
+        &edited,
+        100,
+        &mut Silent,
+    )
+    .expect("edited");
+    assert_eq!(s.notices, want);
 }

@@ -33,11 +33,13 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
     inputs.extend(args.other_model.as_deref());
     offline::output::check_out(&args.out, &inputs, args.force)?;
     let model = offline::load_model(&args.model)?;
-    let frames = if request.replace_from.is_some() || request.add_from.is_some() {
+    let (frames, notices) = if request.replace_from.is_some() || request.add_from.is_some() {
         let take = offline::load_take(&args.file)?;
+        let map = offline::match_take(&model, &take, &args.file)?;
+        let notices = offline::take_notices(&model, (&take.labels, take.rate_hz), &map);
         let out = edit_take(&model, &args.model, &take, &args.file, &request).map_err(usage)?;
         replay::save(&args.out, &out).with_context(|| format!("{}", args.out.display()))?;
-        out.n_frames()
+        (out.n_frames(), notices)
     } else {
         let mut progress = super::progress::for_stderr("edit");
         let done = offline::streamed::edit_file(
@@ -48,8 +50,12 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
             args.block_frames,
             progress.as_mut(),
         );
-        super::progress::settle(progress.as_mut(), done).map_err(usage)?
+        let s = super::progress::settle(progress.as_mut(), done).map_err(usage)?;
+        (s.frames, s.notices)
     };
+    for notice in &notices {
+        crate::out!("warning: {} {notice}", args.file.display());
+    }
     crate::out!("edited {frames} frames -> {}", args.out.display());
     Ok(())
 }

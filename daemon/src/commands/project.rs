@@ -19,10 +19,13 @@ pub(crate) fn run(args: &ProjectArgs) -> Result<()> {
         progress.as_mut(),
     );
     let s = super::progress::settle(progress.as_mut(), done)?;
+    for notice in &s.notices {
+        crate::out!("warning: {} {notice}", args.file.display());
+    }
     crate::out!(
-        "projected {} frames onto {} components ({} with missing markers, {} held) -> {}",
+        "projected {} frames onto {} ({} with missing markers, {} held) -> {}",
         s.frames,
-        s.components,
+        super::count(s.components, "component"),
         s.masked,
         s.held,
         args.out.display()

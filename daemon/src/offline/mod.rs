@@ -14,6 +14,6 @@ pub mod training;
 
 pub use takes::{
     input_paths, load_inputs, load_model, load_model_limited, load_session, load_take,
-    load_take_with, match_take, project_take, resynthesise, set_input_limit, to_model_order,
-    LoadedTake, ModelFrames, Projected,
+    load_take_with, match_take, project_take, resynthesise, set_input_limit, take_notices,
+    to_model_order, LoadedTake, ModelFrames, Projected,
 };

@@ -168,6 +168,26 @@ pub fn frames_in_model_order(take: &Take, map: &LabelMap, range: Range<usize>) -
     }
 }
 
+/// What a user should hear about a take before trusting what a model made of it: markers
+/// that differ from the model's (what the model lacks is filled or left empty, what it does
+/// not have is passed through or ignored), and a rate other than the model's (frames are
+/// projected one by one, as they are). Empty when the take matches.
+pub fn take_notices(model: &IcaModel, take: (&[String], f64), map: &LabelMap) -> Vec<String> {
+    let (labels, rate_hz) = take;
+    let mut notices: Vec<String> = map
+        .differences(model.labels(), labels)
+        .describe("model")
+        .into_iter()
+        .collect();
+    if (rate_hz - model.rate_hz()).abs() > 1e-6 * model.rate_hz() {
+        notices.push(format!(
+            "is at {rate_hz} Hz, the model at {} Hz",
+            model.rate_hz()
+        ));
+    }
+    notices
+}
+
 /// Matches a take to a model by label.
 ///
 /// # Errors

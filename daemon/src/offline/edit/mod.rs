@@ -105,10 +105,21 @@ pub(crate) fn target_point(model: &IcaModel, text: &str) -> Result<(String, Vec<
     Ok((text.to_string(), point))
 }
 
-/// A take projected under a model, ready to align.
+/// A take projected under a model, ready to align. It must have at least half the model's
+/// markers: its emotion is copied whole, and from fewer markers it would be mostly guessed.
 fn project_other(model: &IcaModel, path: &Path) -> Result<Projected> {
     let take = offline::load_take(path)?;
     let map = offline::match_take(model, &take, path)?;
+    let absent = map.absent().count();
+    let markers = model.markers();
+    if 2 * absent > markers {
+        return Err(BadRequest(format!(
+            "{} has only {} of the model's {markers} markers: the emotion to copy needs at least half of them",
+            path.display(),
+            markers - absent
+        ))
+        .into());
+    }
     offline::project_take(model, &offline::to_model_order(&take, &map))
 }
 
@@ -206,6 +217,14 @@ pub(crate) fn plan(request: &EditRequest, model_path: &Path, model: &IcaModel) -
     }
     for &(k, g) in &request.gain {
         plan.gains[check_component(model, k, g, "--gain")?] *= g as f32;
+    }
+    if request.to_emotion.is_some() && request.replace_from.is_some() {
+        // Copy & Replace sets the emotion components to the other take's: a target for them
+        // would be overwritten without a word.
+        return Err(BadRequest(
+            "--to-emotion and --replace-emotion-from both set the emotion: give one".into(),
+        )
+        .into());
     }
     let amount = request.amount;
     if let Some(text) = &request.to_emotion {

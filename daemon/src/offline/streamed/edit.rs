@@ -7,14 +7,23 @@ use anyhow::{bail, Context, Result};
 use ica_core::model::IcaModel;
 use replay::blocks::TakeWriter;
 
-use super::{label_map, run_pass, Frame, FrameSink, PendingOut, Source};
+use super::{label_map, run_pass, source_notices, Frame, FrameSink, PendingOut, Source};
 use crate::engine::frame::FrameProcessor;
 use crate::offline::edit::{plan, ComponentSums, EditRequest, FrameEditor, Output};
 use crate::offline::progress::Progress;
 
+/// What [`edit_file`] did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct EditSummary {
+    /// Frames written.
+    pub frames: usize,
+    /// What the user should hear about the take ([`crate::offline::take_notices`]).
+    pub notices: Vec<String>,
+}
+
 /// Edits the take at `path` (at most `max_bytes`) under `model` (from `model_path`) as
 /// `request` asks and writes it to `out` (format by extension), `block_frames` frames at a
-/// time; returns the frames written. The file is byte for byte what
+/// time. The file is byte for byte what
 /// [`crate::offline::edit::edit_take`] and [`replay::save`] give, except that a TRC or C3D
 /// output of a CSV input (no frame count in its header) gets a padded header.
 ///
@@ -27,7 +36,7 @@ pub fn edit_file(
     out: &Path,
     block_frames: usize,
     progress: &mut dyn Progress,
-) -> Result<usize> {
+) -> Result<EditSummary> {
     if request.replace_from.is_some() || request.add_from.is_some() {
         bail!("Copy & Replace and Copy & Add align whole takes: use edit_take");
     }
@@ -38,6 +47,7 @@ pub fn edit_file(
     let mut plan = plan(request, model_path, model)?;
     let mut source = Source::open(path, max_bytes)?;
     let map = label_map(model, &source)?;
+    let notices = source_notices(model, &source, &map);
     if plan.needs_means() {
         let mut sums = Sums(ComponentSums::new(model.components()));
         let pass = (&mut source, &map);
@@ -71,7 +81,7 @@ pub fn edit_file(
         .finish()
         .with_context(|| format!("{}", out.display()))?;
     pending.commit()?;
-    Ok(frames)
+    Ok(EditSummary { frames, notices })
 }
 
 /// The first pass of a mean-based edit.

@@ -19,7 +19,7 @@ mod output;
 mod project;
 mod source;
 
-pub use edit::edit_file;
+pub use edit::{edit_file, EditSummary};
 pub use project::{project_file, ProjectSummary};
 
 use anyhow::{Context, Result};
@@ -58,6 +58,12 @@ pub(crate) trait FrameSink {
     fn end_block(&mut self) -> Result<()> {
         Ok(())
     }
+}
+
+/// [`crate::offline::take_notices`] of a source.
+pub(crate) fn source_notices(model: &IcaModel, source: &Source, map: &LabelMap) -> Vec<String> {
+    let rate_hz = source.empty_take().rate_hz;
+    crate::offline::take_notices(model, (source.labels(), rate_hz), map)
 }
 
 /// Matches a source's labels to a model's.

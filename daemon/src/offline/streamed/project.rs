@@ -7,12 +7,14 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use ica_core::model::IcaModel;
 
-use super::{label_map, run_pass, Frame, FrameSink, PendingOut, Source};
+use super::{label_map, run_pass, source_notices, Frame, FrameSink, PendingOut, Source};
 use crate::offline::progress::Progress;
 
 /// What [`project_file`] did.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ProjectSummary {
+    /// What the user should hear about the take ([`crate::offline::take_notices`]).
+    pub notices: Vec<String>,
     /// Frames projected.
     pub frames: usize,
     /// Components per frame.
@@ -39,6 +41,7 @@ pub fn project_file(
 ) -> Result<ProjectSummary> {
     let mut source = Source::open(path, max_bytes)?;
     let map = label_map(model, &source)?;
+    let notices = source_notices(model, &source, &map);
     let pending = PendingOut::new(out);
     let file =
         File::create(pending.path()).with_context(|| format!("cannot create {}", out.display()))?;
@@ -69,6 +72,7 @@ pub fn project_file(
     drop(rows.out);
     pending.commit()?;
     Ok(ProjectSummary {
+        notices,
         frames,
         components: model.components(),
         masked: rows.masked,
