@@ -68,8 +68,18 @@ pub(crate) fn analyze_and_write(
     if !report.emotion_note.is_empty() {
         crate::out!("note: {}", report.emotion_note);
     }
-    for (name, level) in &report.levels {
-        crate::out!("level {name}: {level:.4}");
+    match &report.space {
+        Some(space) if space.components.len() > 1 => {
+            for (name, point) in &space.points {
+                let text = super::inspect::point_text(&space.components, &point.level);
+                crate::out!("level {name}: {text}");
+            }
+        }
+        _ => {
+            for (name, level) in &report.levels {
+                crate::out!("level {name}: {level:.4}");
+            }
+        }
     }
     if to.write_model {
         analysis::write_into_model(&mut model, &report)?;

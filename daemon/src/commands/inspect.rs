@@ -34,12 +34,19 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
         r.best_restart
     );
     let emotion = model.emotion();
+    let space = emotion.space_components();
     match emotion.component {
+        Some(k) if space.len() > 1 => {
+            let list: Vec<String> = space.iter().map(|c| format!("c{c}")).collect();
+            crate::out!("emotion:    components {} (main c{k})", list.join(", "));
+        }
         Some(k) => crate::out!("emotion:    component {k}"),
         None => crate::out!("emotion:    not analysed (run `emoshift analyze --write-model`)"),
     }
-    for (name, level) in &emotion.levels {
-        crate::out!("  level {name}: {level:.4}");
+    for name in emotion.names() {
+        if let Some(point) = emotion.point(&name) {
+            crate::out!("  level {name}: {}", point_text(&space, &point));
+        }
     }
     crate::out!("roles:");
     for (k, role) in model.roles().iter().enumerate() {
@@ -51,6 +58,20 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
         return Ok(());
     }
     print_quality(model.quality())
+}
+
+/// An emotion's point: its level on the one emotion component, or `c0 0.1234, c2 -0.5678`
+/// over several.
+pub(crate) fn point_text(components: &[usize], point: &[f64]) -> String {
+    match point {
+        [level] => format!("{level:.4}"),
+        _ => components
+            .iter()
+            .zip(point)
+            .map(|(k, v)| format!("c{k} {v:.4}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
 }
 
 /// Prints a model's quality report: the head decision, stability, residuals and warnings.

@@ -161,7 +161,7 @@ impl SessionStats {
             model: inputs.model_path.display().to_string(),
             manifest: inputs.manifest_path.display().to_string(),
             components,
-            emotion_note: emotion_note(measured, emotion.is_empty(), m),
+            emotion_note: emotion_note(space.as_ref(), emotion.is_empty(), m),
             emotion_components: emotion,
             emotion_measured: measured,
             levels: levels_of(space.as_ref()),
@@ -224,17 +224,47 @@ fn levels_of(space: Option<&EmotionSpace>) -> BTreeMap<String, f64> {
     }
 }
 
-/// Why emotion was not measured or has no component (empty when it has).
-fn emotion_note(measured: bool, no_component: bool, m: usize) -> String {
-    match (measured, no_component) {
-        (false, _) => "emotion not measured: the manifest has no pair of takes with the same \
-                       sentence in two different emotions"
-            .to_string(),
-        (true, true) => format!(
-            "no component's take levels differ between emotions (F test at p < {} over {m} components): no component is labelled emotion",
-            interpret::EMOTION_ALPHA
-        ),
-        (true, false) => String::new(),
+/// Error degrees of freedom under which a session is too small for the emotion test to
+/// find more than a very large effect: say so rather than that there is none.
+const FEW_ERROR_DF: usize = 4;
+
+/// Why emotion was not measured or has no component (empty when it has), with the
+/// strongest effect's numbers when none passed.
+fn emotion_note(space: Option<&EmotionSpace>, no_component: bool, m: usize) -> String {
+    let Some(space) = space else {
+        return "emotion not measured: the manifest has no pair of takes with the same sentence \
+                in two different emotions"
+            .to_string();
+    };
+    if !no_component {
+        return String::new();
+    }
+    let test = format!(
+        "F test at p < {} over {m} components",
+        interpret::EMOTION_ALPHA
+    );
+    let strongest = space
+        .effects
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.f.total_cmp(&b.1.f));
+    let Some((k, e)) = strongest.filter(|(_, e)| e.f > 0.0) else {
+        return format!("no component's take levels differ between emotions ({test})");
+    };
+    let numbers = format!(
+        "the strongest, c{k}, has F = {:.1}, p = {:.2e} on {} error degrees of freedom",
+        e.f, e.p, e.df_error
+    );
+    if e.df_error < FEW_ERROR_DF {
+        format!(
+            "too few takes to tell which components carry emotion ({test}): {numbers}; record \
+             more sentences in each emotion"
+        )
+    } else {
+        format!(
+            "no component's take levels differ between emotions ({test}): {numbers}; no \
+             component is labelled emotion"
+        )
     }
 }
 
