@@ -38,6 +38,19 @@ pub enum TakeError {
         /// Marker label.
         marker: String,
     },
+    /// A sample not flagged missing lies further than [`crate::take::MAX_COORDINATE_MM`]
+    /// from the origin along an axis: no capture volume is that large, the data are corrupt.
+    #[error(
+        "marker {marker:?} at frame index {frame} is at {value:e} mm: past 10 km, not a position (corrupt data?)"
+    )]
+    Implausible {
+        /// 0-based frame index.
+        frame: usize,
+        /// Marker label.
+        marker: String,
+        /// The coordinate, mm.
+        value: f32,
+    },
 }
 
 /// Why a take could not be read.

@@ -2,6 +2,10 @@
 
 use crate::error::TakeError;
 
+/// Largest coordinate of a present sample, mm (10 km): no capture volume comes near it, so a
+/// value past it is corrupt data, not a position ([`Take::validate`]).
+pub const MAX_COORDINATE_MM: f32 = 1.0e7;
+
 /// Length units a file may declare; everything in memory is millimetres.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Units {
@@ -173,7 +177,8 @@ impl Take {
     ///
     /// # Errors
     /// A [`TakeError`] naming the broken invariant: buffer sizes, a non-finite or non-positive
-    /// rate, a non-finite present sample, duplicate or empty labels.
+    /// rate, a non-finite present sample or one past [`MAX_COORDINATE_MM`], duplicate or empty
+    /// labels.
     pub fn validate(&self) -> Result<(), TakeError> {
         let n = self.n_markers();
         if n == 0 {
@@ -198,14 +203,22 @@ impl Take {
             }
         }
         for (i, &gone) in self.missing.iter().enumerate() {
-            if !gone
-                && self.positions[i * 3..i * 3 + 3]
-                    .iter()
-                    .any(|v| !v.is_finite())
-            {
+            if gone {
+                continue;
+            }
+            let (frame, marker) = (i / n, || self.labels[i % n].clone());
+            let xyz = &self.positions[i * 3..i * 3 + 3];
+            if xyz.iter().any(|v| !v.is_finite()) {
                 return Err(TakeError::NonFinite {
-                    frame: i / n,
-                    marker: self.labels[i % n].clone(),
+                    frame,
+                    marker: marker(),
+                });
+            }
+            if let Some(&value) = xyz.iter().find(|v| v.abs() > MAX_COORDINATE_MM) {
+                return Err(TakeError::Implausible {
+                    frame,
+                    marker: marker(),
+                    value,
                 });
             }
         }

@@ -92,6 +92,41 @@ fn nan_and_blank_cells_mean_missing_in_both_formats() {
 }
 
 #[test]
+fn a_coordinate_past_ten_kilometres_is_corrupt_data_named_by_frame_and_marker() {
+    // 9e37 mm: what random bytes in a float field read as.
+    for (text, read) in [
+        (
+            trc_with_row(11, "11\t0.01\t1.5\t2.5\t3.5\t4.5\t9e37\t6.5"),
+            read_trc as fn(&str) -> _,
+        ),
+        (
+            SMALL_CSV.replace(
+                "11,0.01,1.5,2.5,3.5,4.5,5.5",
+                "11,0.01,1.5,2.5,3.5,4.5,9e37",
+            ),
+            read_csv,
+        ),
+    ] {
+        let err = read(&text).unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                ReadError::Invalid(replay::TakeError::Implausible { frame: 1, marker, value })
+                    if marker == "Chin" && *value == 9e37
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("past 10 km"), "{err}");
+    }
+    // 9.99 km is still a number a file may hold (a take in metres read as millimetres).
+    assert!(read_trc(&trc_with_row(
+        11,
+        "11\t0.01\t1.5\t2.5\t3.5\t4.5\t9990000\t6.5"
+    ))
+    .is_ok());
+}
+
+#[test]
 fn bad_cells_name_line_column_and_marker() {
     let cases = [
         (
