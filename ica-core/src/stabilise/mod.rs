@@ -20,7 +20,7 @@ mod assess;
 mod sample;
 pub mod search;
 
-pub use assess::GroupAssessment;
+pub use assess::{GroupAssessment, MIN_MOTION_MM, MOTION_FACTOR};
 pub use sample::MarkerFrames;
 pub use search::{assess_named, choose, search_reference, Choice, ReferenceSearch, SearchParams};
 

@@ -16,6 +16,7 @@ use globset::{GlobBuilder, GlobSetBuilder};
 use ica_core::quality::HeadReport;
 use ica_core::stabilise::{
     assess_named, choose, search_reference, Choice, GroupAssessment, MarkerFrames, SearchParams,
+    MIN_MOTION_MM, MOTION_FACTOR,
 };
 use replay::session::Regions;
 
@@ -139,7 +140,9 @@ fn with_numbers(mut report: HeadReport, a: &GroupAssessment) -> HeadReport {
     report
 }
 
-/// Named markers (by the user or a naming convention): used unless the head is still.
+/// Named markers (by the user or a naming convention): used unless the head's motion is too
+/// small for stabilising on them to pay (the verdict says which: a still head, or motion
+/// under [`MOTION_FACTOR`] times the pose error they would add).
 fn from_named(
     source: &str,
     markers: Vec<usize>,
@@ -164,10 +167,18 @@ fn from_named(
     };
     let mut report = with_numbers(report, &a);
     if !a.motion_is_measurable() {
-        report.verdict = format!(
-            "not stabilised: the head is still (it moves the face by {:.2} mm RMS, against {:.2} mm of pose error the reference would add)",
-            a.motion_mm, a.pose_error_mm
-        );
+        let why = if a.motion_mm <= MIN_MOTION_MM {
+            format!(
+                "the head is still (it moves the face by {:.2} mm RMS)",
+                a.motion_mm
+            )
+        } else {
+            format!(
+                "the head moves the face by {:.2} mm RMS, less than {MOTION_FACTOR} times the {:.2} mm of pose error the reference would add",
+                a.motion_mm, a.pose_error_mm
+            )
+        };
+        report.verdict = format!("not stabilised: {why}");
         return HeadDecision {
             markers: Vec::new(),
             report,
