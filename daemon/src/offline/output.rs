@@ -36,6 +36,14 @@ pub fn check_out(out: &Path, inputs: &[&Path], force: bool) -> Result<()> {
         ))
         .into());
     }
+    if out.is_dir() {
+        // --force cannot help: the output is a file.
+        return Err(UsageError(format!(
+            "{} is a folder; name the output file",
+            out.display()
+        ))
+        .into());
+    }
     let exists = std::fs::symlink_metadata(out).is_ok();
     if exists && !force {
         return Err(UsageError(format!(
@@ -84,5 +92,7 @@ mod tests {
         assert!(e.to_string().contains("--force"), "{e}");
         assert!(check_out(&take, &[], true).is_ok());
         assert!(check_out(&dir.path().join("new.trc"), &[&take], false).is_ok());
+        let e = check_out(dir.path(), &[&take], true).expect_err("a folder");
+        assert!(e.to_string().contains("is a folder"), "{e}");
     }
 }

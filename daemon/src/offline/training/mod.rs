@@ -25,7 +25,7 @@ mod stream;
 
 use std::ops::Range;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use ica_core::model::CaptureSettings;
 use ica_core::quality::HeadReport;
 use ica_core::robust::quantile;
@@ -279,7 +279,7 @@ pub(crate) struct KeptMarkers {
 fn kept_markers(takes: &[replay::Take], names: &[String], max_share: f64) -> Result<KeptMarkers> {
     let mut counts = MissingCounts::new(takes[0].labels.clone());
     for (t, name) in takes.iter().zip(names) {
-        counts.add(t, name)?;
+        counts.add(t, name).with_context(|| name.clone())?;
     }
     counts.kept(max_share)
 }
@@ -311,7 +311,14 @@ impl MissingCounts {
     /// # Errors
     /// The take shares no marker with the first.
     pub(crate) fn add(&mut self, t: &replay::Take, name: &str) -> Result<()> {
-        let map = LabelMap::new(&self.first, &t.labels)?;
+        // The layout error speaks of a model; here there is only the first take.
+        let map = LabelMap::new(&self.first, &t.labels).map_err(|_| {
+            anyhow::anyhow!(
+                "shares no marker with the first take (its {} markers, the first take's {})",
+                t.labels.len(),
+                self.first.len()
+            )
+        })?;
         if let Some(text) = map
             .differences(&self.first, &t.labels)
             .describe("first take")
