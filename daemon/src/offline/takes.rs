@@ -169,9 +169,9 @@ pub fn frames_in_model_order(take: &Take, map: &LabelMap, range: Range<usize>) -
 }
 
 /// What a user should hear about a take before trusting what a model made of it: markers
-/// that differ from the model's (what the model lacks is filled or left empty, what it does
-/// not have is passed through or ignored), and a rate other than the model's (frames are
-/// projected one by one, as they are). Empty when the take matches.
+/// that differ from the model's (the model's markers the take lacks are filled or left empty,
+/// the take's the model does not have are passed through or ignored), and a rate other than
+/// the model's (frames are projected one by one, as they are). Empty when the take matches.
 pub fn take_notices(model: &IcaModel, take: (&[String], f64), map: &LabelMap) -> Vec<String> {
     let (labels, rate_hz) = take;
     let mut notices: Vec<String> = map
