@@ -18,7 +18,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use globset::{Glob, GlobMatcher};
+use globset::{Glob, GlobBuilder, GlobMatcher};
 use serde::{Deserialize, Serialize};
 
 /// File name of the session manifest inside a session folder.
@@ -82,20 +82,24 @@ pub enum SessionError {
         source: globset::Error,
     },
     /// A literal (non-glob) label of a region is not among the markers.
-    #[error("region {region:?} names marker {label:?}, which the take does not have")]
+    #[error("region {region:?} names marker {label:?}, which the take does not have{hint}")]
     UnknownLabel {
         /// Region name.
         region: String,
         /// The missing label.
         label: String,
+        /// What the take has instead (see [`near_labels`]).
+        hint: String,
     },
     /// A region's patterns match none of the markers.
-    #[error("region {region:?} matches no marker (patterns {patterns:?})")]
+    #[error("region {region:?} matches no marker (patterns {patterns:?}){hint}")]
     EmptyRegion {
         /// Region name.
         region: String,
         /// Its patterns.
         patterns: Vec<String>,
+        /// What the take has instead (see [`near_labels`]).
+        hint: String,
     },
     /// Serialising to TOML failed.
     #[error("cannot serialise to toml")]
@@ -305,6 +309,7 @@ impl Regions {
                         SessionError::UnknownLabel {
                             region: name.clone(),
                             label: p.clone(),
+                            hint: near_labels(labels, std::slice::from_ref(p)),
                         }
                     })?;
                     hit[i] = true;
@@ -315,11 +320,57 @@ impl Regions {
                 return Err(SessionError::EmptyRegion {
                     region: name.clone(),
                     patterns: patterns.clone(),
+                    hint: near_labels(labels, patterns),
                 });
             }
             out.insert(name.clone(), idx);
         }
         Ok(out)
+    }
+}
+
+/// Labels shown at most by [`near_labels`].
+const NEAR_SHOWN: usize = 6;
+
+/// For a region that matched nothing: the labels its `patterns` match ignoring case (labels
+/// are case-sensitive: `ROOT-*` does not match `root-1`), or else the first of the take's
+/// labels, so the message shows what to write.
+fn near_labels<S: AsRef<str>>(labels: &[S], patterns: &[String]) -> String {
+    let folded: Vec<GlobMatcher> = patterns
+        .iter()
+        .filter_map(|p| {
+            GlobBuilder::new(p)
+                .case_insensitive(true)
+                .build()
+                .ok()
+                .map(|g| g.compile_matcher())
+        })
+        .collect();
+    let near: Vec<&str> = labels
+        .iter()
+        .map(AsRef::as_ref)
+        .filter(|l| folded.iter().any(|m| m.is_match(l)))
+        .collect();
+    let list = |shown: &[&str], all: usize| {
+        let mut text = shown
+            .iter()
+            .take(NEAR_SHOWN)
+            .map(|l| format!("{l:?}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        if all > NEAR_SHOWN {
+            text.push_str(&format!(" and {} more", all - NEAR_SHOWN));
+        }
+        text
+    };
+    if near.is_empty() {
+        let all: Vec<&str> = labels.iter().map(AsRef::as_ref).collect();
+        format!("; its markers are {}", list(&all, all.len()))
+    } else {
+        format!(
+            "; labels are case-sensitive, and the take has {}",
+            list(&near, near.len())
+        )
     }
 }
 
@@ -380,6 +431,17 @@ mod tests {
         let typo = Regions::parse("mouth = [\"UpperLip*\", \"UperLip2\"]").expect("parses");
         let err = typo.resolve(&labels).expect_err("unknown literal label");
         assert!(err.to_string().contains("UperLip2"));
+        assert!(err.to_string().contains("its markers are"), "{err}");
+        // Labels are case-sensitive; the message names what the pattern meant.
+        let case = Regions::parse("brows = [\"BROW*\"]").expect("parses");
+        let err = case.resolve(&labels).expect_err("case differs").to_string();
+        assert!(
+            err.contains("case-sensitive") && err.contains("\"BrowL1\""),
+            "{err}"
+        );
+        let case = Regions::parse("brows = [\"browl1\"]").expect("parses");
+        let err = case.resolve(&labels).expect_err("case differs").to_string();
+        assert!(err.contains("the take has \"BrowL1\""), "{err}");
         assert!(Regions::parse("mouth = [\"[\"]").is_err());
         let ok = Regions::parse("mouth = [\"UpperLip*\"]\nbrows = [\"BrowL1\"]").expect("parses");
         let r = ok.resolve(&labels).expect("resolves");
