@@ -198,6 +198,17 @@ pub enum ConfigError {
     /// No model given.
     #[error("no model: pass --model model.json or set model in the config")]
     NoModel,
+    /// The frame and control sockets on one UDP port.
+    #[error(
+        "listen {listen} and control {control} share a port: the frame socket and the control \
+         socket each need their own"
+    )]
+    SharedPort {
+        /// The frame socket.
+        listen: SocketAddr,
+        /// The control socket.
+        control: SocketAddr,
+    },
 }
 
 impl RawConfig {
@@ -242,9 +253,14 @@ impl RawConfig {
             }
             None => Ok(default),
         };
+        let listen = addr("listen", self.listen, DEFAULT_LISTEN)?;
+        let control = addr("control", self.control, DEFAULT_CONTROL)?;
+        if shares_port(listen, control) {
+            return Err(ConfigError::SharedPort { listen, control });
+        }
         Ok(Config {
-            listen: addr("listen", self.listen, DEFAULT_LISTEN)?,
-            control: addr("control", self.control, DEFAULT_CONTROL)?,
+            listen,
+            control,
             model: self.model.ok_or(ConfigError::NoModel)?,
             send,
             max_subscribers: self
@@ -332,6 +348,15 @@ struct Numbers {
     stats_interval: Duration,
     lease: Duration,
     max_model_bytes: u64,
+}
+
+/// Two UDP sockets that cannot both bind: one port on one address, or on any address
+/// (`0.0.0.0` or `::`) and another of the same family.
+fn shares_port(a: SocketAddr, b: SocketAddr) -> bool {
+    a.port() == b.port()
+        && a.port() != 0
+        && a.is_ipv4() == b.is_ipv4()
+        && (a.ip() == b.ip() || a.ip().is_unspecified() || b.ip().is_unspecified())
 }
 
 #[cfg(test)]

@@ -96,3 +96,27 @@ fn stage_keys_are_checked_and_named() {
         "line 3, key queue: invalid type: string \"big\", expected usize"
     );
 }
+
+#[test]
+fn the_frame_and_control_sockets_need_their_own_ports() {
+    let validate = |text: &str| {
+        RawConfig::from_toml(&format!("model = \"m\"\n{text}\n"))
+            .expect("parses")
+            .validate()
+    };
+    for clash in [
+        "listen = \"127.0.0.1:9300\"\ncontrol = \"127.0.0.1:9300\"",
+        "listen = \"0.0.0.0:9300\"\ncontrol = \"127.0.0.1:9300\"",
+    ] {
+        let e = validate(clash).expect_err("one port");
+        assert!(e.to_string().contains("share a port"), "{e}");
+    }
+    // Another address of the loopback network, or another family, binds beside it.
+    for apart in [
+        "listen = \"127.0.0.1:9300\"\ncontrol = \"127.0.0.2:9300\"",
+        "listen = \"[::1]:9300\"\ncontrol = \"127.0.0.1:9300\"",
+        "listen = \"127.0.0.1:9300\"\ncontrol = \"127.0.0.1:9301\"",
+    ] {
+        validate(apart).expect("own sockets");
+    }
+}
