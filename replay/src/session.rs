@@ -88,7 +88,8 @@ pub enum SessionError {
         region: String,
         /// The missing label.
         label: String,
-        /// What the take has instead (see [`near_labels`]).
+        /// What the take has instead: labels the patterns match ignoring case, or its first
+        /// markers.
         hint: String,
     },
     /// A region's patterns match none of the markers.
@@ -98,7 +99,8 @@ pub enum SessionError {
         region: String,
         /// Its patterns.
         patterns: Vec<String>,
-        /// What the take has instead (see [`near_labels`]).
+        /// What the take has instead: labels the patterns match ignoring case, or its first
+        /// markers.
         hint: String,
     },
     /// Serialising to TOML failed.
