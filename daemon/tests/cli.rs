@@ -277,3 +277,49 @@ fn analyze_without_pairs_reports_regions_and_why_emotion_is_missing() {
     );
     assert!(!roles.contains(&"emotion"));
 }
+
+#[test]
+fn a_head_reference_asked_for_and_not_used_is_a_warning_and_a_regions_file_is_not() {
+    // synth without --head-motion: the head is still, so stabilising on it would add more
+    // pose error than it removes, whoever named it.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let s = dir.path().join("s");
+    ok(&["synth", "--out", p(&s), "--sentences", "2", "--seed", "4"]);
+    let manifest = s.join("session.toml");
+    let model = dir.path().join("m.json");
+    let train = |extra: &[&str]| {
+        let mut args = vec![
+            "train",
+            "--force",
+            "--manifest",
+            p(&manifest),
+            "--out",
+            p(&model),
+        ];
+        args.extend(extra);
+        let out = ok(&args);
+        let json = std::fs::read_to_string(&model).expect("model");
+        (out, json)
+    };
+    // The session's regions file names the head markers: a description, not a request.
+    let (out, json) = train(&[]);
+    assert!(
+        out.contains("head reference (named): not stabilised"),
+        "{out}"
+    );
+    assert!(!out.contains("--head-reference"), "{out}");
+    assert!(!json.contains("\"requested\""), "not written when false");
+    let (out, json) = train(&["--head-reference", "Head*"]);
+    let warning = out
+        .lines()
+        .find(|l| l.contains("named by --head-reference"))
+        .unwrap_or_else(|| panic!("a warning: {out}"));
+    assert!(
+        warning.contains("HeadFront") && warning.contains("not stabilised"),
+        "{warning}"
+    );
+    assert!(
+        json.contains("named by --head-reference"),
+        "in the model's warnings"
+    );
+}

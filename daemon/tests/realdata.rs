@@ -41,7 +41,10 @@ fn options(head: &[&str]) -> PrepOptions {
         rate_hz: None,
         max_missing_share: 0.5,
         speed: SpeedLimit::Auto,
-        head: HeadChoice::Labels(head.iter().map(|h| h.to_string()).collect()),
+        head: HeadChoice::Labels {
+            patterns: head.iter().map(|h| h.to_string()).collect(),
+            requested: true,
+        },
         bounds: true,
     }
 }

@@ -46,11 +46,17 @@ fn head_choice(
         return match text {
             "none" => HeadChoice::None,
             "auto" => auto,
-            list => HeadChoice::Labels(list.split(',').map(|s| s.trim().to_string()).collect()),
+            list => HeadChoice::Labels {
+                patterns: list.split(',').map(|s| s.trim().to_string()).collect(),
+                requested: true,
+            },
         };
     }
     match regions.and_then(|r| r.regions.get(HEAD_REGION)) {
-        Some(patterns) => HeadChoice::Labels(patterns.clone()),
+        Some(patterns) => HeadChoice::Labels {
+            patterns: patterns.clone(),
+            requested: false,
+        },
         None => auto,
     }
 }

@@ -41,6 +41,11 @@ pub struct HeadReport {
     /// Stabilisation residual per reference marker over the training frames (mm RMS).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub residual_mm: BTreeMap<String, f64>,
+    /// The user asked for this reference on the command line (`--head-reference`), so not
+    /// using it is a warning. A regions file's `head_reference` describes the layout and asks
+    /// nothing.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub requested: bool,
 }
 
 /// The kind of a [`Warning`], for tests and tools.

@@ -36,7 +36,13 @@ pub enum HeadChoice {
         patterns: Vec<String>,
     },
     /// These labels or glob patterns (as in a regions file), named by the user.
-    Labels(Vec<String>),
+    Labels {
+        /// Labels or glob patterns.
+        patterns: Vec<String>,
+        /// Asked for on the command line (a regions file only describes the layout): not
+        /// using them is a warning ([`HeadReport::requested`]).
+        requested: bool,
+    },
 }
 
 impl HeadChoice {
@@ -78,9 +84,14 @@ pub fn decide(
                 ..HeadReport::default()
             },
         }),
-        HeadChoice::Labels(patterns) => {
+        HeadChoice::Labels {
+            patterns,
+            requested,
+        } => {
             let markers = resolve_named(patterns, labels)?;
-            Ok(from_named("named", markers, labels, frames))
+            let mut decision = from_named("named", markers, labels, frames);
+            decision.report.requested = *requested;
+            Ok(decision)
         }
         HeadChoice::Auto { patterns } => {
             let matched = match_patterns(patterns, labels)?;

@@ -124,6 +124,19 @@ fn warn_head(q: &mut ModelQuality) {
     let Some(h) = q.head.clone() else {
         return;
     };
+    if h.requested && !h.stabilised {
+        let why = h
+            .verdict
+            .strip_prefix("not stabilised: ")
+            .unwrap_or(&h.verdict);
+        q.warn(
+            WarningKind::HeadReference,
+            format!(
+                "the head reference named by --head-reference ({}) is not used, and frames are not stabilised: {why}",
+                h.markers.join(", ")
+            ),
+        );
+    }
     if h.stabilised && h.rigid == Some(false) {
         q.warn(
             WarningKind::HeadReference,
