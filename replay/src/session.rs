@@ -353,25 +353,25 @@ fn near_labels<S: AsRef<str>>(labels: &[S], patterns: &[String]) -> String {
         .map(AsRef::as_ref)
         .filter(|l| folded.iter().any(|m| m.is_match(l)))
         .collect();
-    let list = |shown: &[&str], all: usize| {
+    let list = |shown: &[&str]| {
         let mut text = shown
             .iter()
             .take(NEAR_SHOWN)
             .map(|l| format!("{l:?}"))
             .collect::<Vec<_>>()
             .join(", ");
-        if all > NEAR_SHOWN {
-            text.push_str(&format!(" and {} more", all - NEAR_SHOWN));
+        if shown.len() > NEAR_SHOWN {
+            text.push_str(&format!(" and {} more", shown.len() - NEAR_SHOWN));
         }
         text
     };
     if near.is_empty() {
         let all: Vec<&str> = labels.iter().map(AsRef::as_ref).collect();
-        format!("; its markers are {}", list(&all, all.len()))
+        format!("; its markers are {}", list(&all))
     } else {
         format!(
             "; labels are case-sensitive, and the take has {}",
-            list(&near, near.len())
+            list(&near)
         )
     }
 }
