@@ -146,7 +146,7 @@ pub struct TrainArgs {
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// Stream the takes even when the session is short enough to train in memory (sessions
-    /// longer than 50,000 frames always stream, in bounded memory).
+    /// longer than 4,000 frames always stream, in bounded memory).
     #[arg(long)]
     pub stream: bool,
     /// Overwrite the output if it exists.
