@@ -42,8 +42,9 @@ impl Sample {
         let n = frames.markers;
         let inner: usize = frames.takes.iter().map(|r| r.len().saturating_sub(2)).sum();
         let stride = (inner / max_frames.max(1)).max(1);
-        let mut xyz = Vec::new();
-        let mut present = Vec::new();
+        let sampled = inner / stride;
+        let mut xyz = Vec::with_capacity(sampled * 3 * n * 3);
+        let mut present = Vec::with_capacity(sampled * 3 * n);
         let mut k = 0usize;
         for take in frames.takes {
             for f in take.start + 1..take.end.saturating_sub(1) {

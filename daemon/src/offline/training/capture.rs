@@ -38,7 +38,11 @@ pub(super) fn learn(
     let n = labels.len();
     // 1. The head: decided on the raw frames, template from them (its Procrustes mean shrugs
     //    off rare glitches).
-    let (mut raw_xyz, mut raw_missing) = (Vec::new(), Vec::new());
+    let held: usize = frames.iter().map(ModelFrames::frames).sum();
+    let (mut raw_xyz, mut raw_missing) = (
+        Vec::with_capacity(held * n * 3),
+        Vec::with_capacity(held * n),
+    );
     for f in frames {
         raw_xyz.extend_from_slice(&f.xyz);
         raw_missing.extend_from_slice(&f.missing);

@@ -102,6 +102,7 @@ impl Collected {
     pub(super) fn new(markers: usize, total: usize, rate_hz: f64, raw: &mut Spill) -> Result<Self> {
         let c = markers * 3;
         let slow_block = slow_block_frames(rate_hz);
+        let residual = residual_stride(total);
         Ok(Self {
             channels: c,
             moments: Moments::new(c),
@@ -113,11 +114,12 @@ impl Collected {
             glitches_per_marker: vec![0; markers],
             residuals: Thinned::new(RESIDUALS_KEPT),
             noise_d2: vec![Vec::new(); c],
-            residual_frames: Vec::new(),
+            // At its most, reserved once: pages never used are never touched.
+            residual_frames: Vec::with_capacity(total.div_ceil(residual) * c),
             slow_means: Vec::new(),
             frame: 0,
             strides: (
-                residual_stride(total),
+                residual,
                 noise_stride(total),
                 slow_block_stride(total, slow_block),
             ),

@@ -120,7 +120,7 @@ impl TakePrep<'_> {
     /// # Errors
     /// A frame buffer that does not match the markers (an internal invariant).
     pub(super) fn prepare(&self, bytes: &[u8]) -> Result<PreparedTake> {
-        let raw = narrow(&self.unspill(bytes), self.kept);
+        let raw = narrow(self.unspill(bytes), self.kept);
         let n = self.kept.len();
         let frames = raw.frames();
         let mut prep = FramePrep::new(n, self.rate_hz, self.capture);
