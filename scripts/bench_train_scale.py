@@ -97,8 +97,16 @@ def report(path):
         per = [t / f for f, t in points]
         print(f"\nscaling exponent (time ~ frames^k): k = {slope:.3f}; time per frame, largest "
               f"session / smallest: {per[-1] / per[0]:.3f}")
-        # Run by run (the sizes took turns), so drift over minutes falls on both alike.
         sizes = [size for size in train if size != "12k"]
+        # The reading of linear cost: every size's time per frame (median run) within
+        # 20 % of every other's, not only the smallest against the largest.
+        per_size = {size: statistics.median(r[0] for r in train[size]) / train[size][0][2]
+                    for size in sizes}
+        lo, hi = min(per_size, key=per_size.get), max(per_size, key=per_size.get)
+        print(f"time per frame from {sizes[0]} to {sizes[-1]}: cheapest {1e6 * per_size[lo]:.1f} µs "
+              f"({lo}), dearest {1e6 * per_size[hi]:.1f} µs ({hi}): a spread of "
+              f"{per_size[hi] / per_size[lo]:.2f}")
+        # Run by run (the sizes took turns), so drift over minutes falls on both alike.
         small, large = train[sizes[0]], train[sizes[-1]]
         for name, col in (("wall time", 0), ("CPU time", 4)):
             pairs = [(a, b) for a, b in zip(small, large) if len(a) > col and len(b) > col]
