@@ -106,6 +106,17 @@ def report(path):
         print(f"time per frame from {sizes[0]} to {sizes[-1]}: cheapest {1e6 * per_size[lo]:.1f} µs "
               f"({lo}), dearest {1e6 * per_size[hi]:.1f} µs ({hi}): a spread of "
               f"{per_size[hi] / per_size[lo]:.2f}")
+        # What a frame more costs between neighbouring sizes, which a fixed part does not
+        # weigh on, and the fixed part the two smallest sizes imply: the spread above holds
+        # only when that part is under a fifth of the smallest session's time at the rate.
+        marginal = [(tb - ta) / (fb - fa) for (fa, ta), (fb, tb) in zip(points, points[1:])]
+        steps = [f"{a} to {b} {1e6 * r:.1f} µs" for a, b, r in zip(sizes, sizes[1:], marginal)]
+        print(f"time per frame more, between sizes: {', '.join(steps)}; spread "
+              f"{max(marginal) / min(marginal):.2f}")
+        (f0, t0), rate = points[0], marginal[0]
+        print(f"fixed part at {sizes[0]} (its time less its frames at the {sizes[0]} to "
+              f"{sizes[1]} rate): {t0 - rate * f0:.2f} s; within 20 % needs it under "
+              f"{0.2 * rate * f0:.2f} s")
         # Run by run (the sizes took turns), so drift over minutes falls on both alike.
         small, large = train[sizes[0]], train[sizes[-1]]
         for name, col in (("wall time", 0), ("CPU time", 4)):
