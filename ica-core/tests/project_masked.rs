@@ -154,6 +154,64 @@ fn whole_mouth_hidden_is_flagged_and_holds_the_speech_component() {
     }
 }
 
+/// A long occlusion with the model's own prior (a trained model's residual variance): each
+/// ill-conditioned frame's solution becomes the next frame's prior, so a solve that moves the
+/// unseen component off its prior compounds frame after frame. It must hold instead (on
+/// Facial-Sing, hiding every face marker for ten frames had sent the output metres away).
+#[test]
+fn a_long_occlusion_holds_the_unseen_component_with_the_models_prior() {
+    let mut rng = ChaCha8Rng::seed_from_u64(15);
+    let base = face_model(&mut rng);
+    // Discarded eigenvalues worth 0.05 mm² per channel: the prior's weight, as training sets it.
+    let mut report = report();
+    report.eigenvalues = [
+        vec![100.0; M],
+        vec![0.05 * N as f64 / (N - M) as f64; N - M],
+    ]
+    .concat();
+    let model = IcaModel::new(
+        base.labels().to_vec(),
+        120.0,
+        base.mean().to_vec(),
+        base.mixing().clone(),
+        report,
+    )
+    .expect("full rank");
+    assert!((model.residual_variance() - 0.05).abs() < 1e-9);
+    let mut p = Projector::new(&model);
+    let edit = FrameEdit::identity(M);
+    let (mut u, mut out) = (vec![0.0_f32; M], vec![0.0_f32; N]);
+    let u_prev = DVector::from_fn(M, |_, _| 3.0 * normal(&mut rng));
+    let (x_prev, _) = frame(&model, &u_prev, 0.0, &mut rng);
+    p.process_into(&x_prev, None, &edit, &mut out, &mut u)
+        .expect("sizes");
+    let prior = u[SPEECH];
+    let mut mask = vec![false; MARKERS];
+    mask[MOUTH].fill(true);
+    for f in 0..300 {
+        let mut u_true = u_prev.clone();
+        u_true[0] += (f as f64 * 0.05).sin();
+        let (x, _) = frame(&model, &u_true, 0.05, &mut rng);
+        let status = p
+            .process_into(&x, Some(&mask), &edit, &mut out, &mut u)
+            .expect("sizes");
+        assert!(
+            (u[SPEECH] - prior).abs() < 0.05,
+            "frame {f}: speech {} drifted from {prior}",
+            u[SPEECH]
+        );
+        assert!(
+            (f64::from(u[0]) - u_true[0]).abs() < 0.05,
+            "frame {f}: a visible component stopped following the data"
+        );
+        // Measured on the data alone: the prior does not make the mouth observable.
+        assert!(
+            status.ill_conditioned && status.observability < 1e-3,
+            "frame {f}: {status:?}"
+        );
+    }
+}
+
 #[test]
 fn fewer_observed_channels_than_components_holds() {
     let mut rng = ChaCha8Rng::seed_from_u64(13);

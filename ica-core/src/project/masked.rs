@@ -125,11 +125,8 @@ impl MaskedSolver {
         }
         self.build_gram(hidden, hidden_count);
         self.factor.copy_from_slice(&self.gram);
+        // Observability is measured on the data alone; the solve then adds the priors.
         let ok = cholesky(&mut self.factor, &mut self.pivots, m);
-        // Observability is measured on the data alone (above); the solve adds the prior.
-        if ok && self.residual_var > 0.0 {
-            self.add_prior(prior);
-        }
         let observability = if ok {
             self.pivots
                 .iter()
@@ -140,8 +137,13 @@ impl MaskedSolver {
             0.0
         };
         let ill_conditioned = observability < MIN_OBSERVABILITY;
-        if ill_conditioned {
-            self.regularise(prior);
+        let ridge = if ill_conditioned {
+            MIN_OBSERVABILITY
+        } else {
+            0.0
+        };
+        if self.residual_var > 0.0 || ridge > 0.0 {
+            self.add_priors(prior, ridge);
         }
         solve_factored(&self.factor, &self.rhs, &mut self.sol, m);
         for (ui, s) in u.iter_mut().zip(&self.sol) {
@@ -174,29 +176,24 @@ impl MaskedSolver {
         }
     }
 
-    /// The model's prior: `(G + σ² I) u = b + σ² μ`.
-    fn add_prior(&mut self, prior: &[f32]) {
-        self.factor.copy_from_slice(&self.gram);
-        for (k, (r, &p)) in self.rhs.iter_mut().zip(prior).enumerate() {
-            self.factor[off(k) + k] += self.residual_var;
-            *r += self.residual_var * f64::from(p);
-        }
-        let ok = cholesky(&mut self.factor, &mut self.pivots, self.m);
-        debug_assert!(ok, "G + σ²I is positive definite when G is");
-    }
-
-    /// Ridge toward `prior`: `(G + λD) u = b + λD prior` with `D = diag(MᵀM)`, `λ =`
-    /// [`MIN_OBSERVABILITY`]. Positive definite whatever is hidden, since `D > 0`.
-    fn regularise(&mut self, prior: &[f32]) {
+    /// The priors, both toward `prior` (`μ`): the model's, `σ² I`, and when the frame is
+    /// ill-conditioned a ridge `λD` with `D = diag(MᵀM)`, `λ = ridge`:
+    /// `(G + σ² I + λD) u = b + (σ² I + λD) μ`, so `u = μ + (G + σ² I + λD)⁻¹ (b − Gμ)`: what
+    /// the data do not determine stays at `μ`. Positive definite whatever is hidden once either
+    /// prior is there (`σ² > 0` or `λ > 0`, `D > 0`).
+    fn add_priors(&mut self, prior: &[f32], ridge: f64) {
         self.factor.copy_from_slice(&self.gram);
         for (k, (r, &p)) in self.rhs.iter_mut().zip(prior).enumerate() {
             let kk = off(k) + k;
-            let d = MIN_OBSERVABILITY * self.gram_full[kk];
+            let d = self.residual_var + ridge * self.gram_full[kk];
             self.factor[kk] += d;
             *r += d * f64::from(p);
         }
         let ok = cholesky(&mut self.factor, &mut self.pivots, self.m);
-        debug_assert!(ok, "G + λD is positive definite for λ > 0 and D > 0");
+        debug_assert!(
+            ok,
+            "G + σ²I + λD is positive definite when a prior is there"
+        );
     }
 }
 
