@@ -221,6 +221,66 @@ fn train_project_edit_round_trip_on_synth_output() {
         .sum::<f64>()
         .sqrt();
     assert!(moved > 1.0, "the edit changed nothing ({moved})");
+    // Negative values are values, and the live controls' bounds hold offline.
+    let happy = s.join("s01_happy.c3d");
+    let take = p(&happy);
+    let back = dir.path().join("back.trc");
+    ok(&[
+        "edit",
+        "--model",
+        p(&model),
+        take,
+        "--out",
+        p(&back),
+        "--translate",
+        "0=-2",
+    ]);
+    let usage = |args: &[&str], needle: &str| {
+        let out = run(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "emoshift {args:?}: {err}");
+        assert!(err.contains(needle), "{err:?} should name {needle:?}");
+    };
+    let other = dir.path().join("other.trc");
+    let other = p(&other);
+    usage(
+        &[
+            "edit",
+            "--model",
+            p(&model),
+            take,
+            "--out",
+            other,
+            "--gain",
+            "1=11",
+        ],
+        "outside -10..10",
+    );
+    usage(
+        &[
+            "edit",
+            "--model",
+            p(&model),
+            take,
+            "--out",
+            other,
+            "--translate",
+            "1=1e6",
+        ],
+        "outside -100..100",
+    );
+    // An output named as a take format the command does not write.
+    let wrong = dir.path().join("u.c3d");
+    let wrong = p(&wrong);
+    usage(
+        &["project", "--model", p(&model), take, "--out", wrong],
+        "name the output .csv",
+    );
+    usage(
+        &["train", take, "--out", p(&dir.path().join("m.trc"))],
+        "name the output .json",
+    );
+    assert!(!dir.path().join("u.c3d").exists() && !dir.path().join("m.trc").exists());
 }
 
 #[test]

@@ -107,7 +107,12 @@ pub struct TrainArgs {
     #[arg(long, default_value_t = ica_core::fit::DEFAULT_MAX_ITER)]
     pub max_iter: usize,
     /// Convergence tolerance.
-    #[arg(long, default_value_t = ica_core::fit::DEFAULT_TOL, value_parser = super::values::positive)]
+    #[arg(
+        long,
+        default_value_t = ica_core::fit::DEFAULT_TOL,
+        value_parser = super::values::positive,
+        allow_negative_numbers = true
+    )]
     pub tol: f64,
     /// Model rate in Hz; takes at other rates are resampled (default: the manifest's
     /// `rate_hz`, else the first take's rate).
@@ -187,11 +192,12 @@ pub struct EditArgs {
     /// --to-emotion reads the file twice); Copy & Replace and Copy & Add hold both takes whole.
     #[arg(long)]
     pub out: PathBuf,
-    /// Translate component k by alpha: `--translate 2=0.5` (repeatable).
-    #[arg(long, value_parser = parse_key_value)]
+    /// Translate component k by alpha (component units, |alpha| at most 100, as live):
+    /// `--translate 2=0.5`, `--translate 2=-1` (repeatable).
+    #[arg(long, value_parser = parse_translate, allow_hyphen_values = true)]
     pub translate: Vec<KeyValue>,
-    /// Multiply component k by g: `--gain 0=1.2` (repeatable).
-    #[arg(long, value_parser = parse_key_value)]
+    /// Multiply component k by g (|g| at most 10, as live): `--gain 0=1.2` (repeatable).
+    #[arg(long, value_parser = parse_gain, allow_hyphen_values = true)]
     pub gain: Vec<KeyValue>,
     /// Move the emotion towards a named level (needs an analysed model).
     #[arg(long, value_name = "NAME")]
@@ -201,7 +207,8 @@ pub struct EditArgs {
         long,
         default_value_t = 1.0,
         requires = "to_emotion",
-        value_parser = super::values::finite
+        value_parser = super::values::finite,
+        allow_negative_numbers = true
     )]
     pub amount: f64,
     /// With --to-emotion: edit as the live daemon does, from a causal low-pass of the emotion
@@ -210,7 +217,8 @@ pub struct EditArgs {
         long,
         value_name = "SECONDS",
         requires = "to_emotion",
-        value_parser = super::values::non_negative
+        value_parser = super::values::non_negative,
+        allow_negative_numbers = true
     )]
     pub lowpass: Option<f64>,
     /// Copy & Replace: take the emotion series of another take (DTW-aligned to this one; both
@@ -252,6 +260,24 @@ pub struct KeyValue {
     pub key: usize,
     /// Value.
     pub value: f64,
+}
+
+fn parse_translate(text: &str) -> Result<KeyValue, String> {
+    bounded(text, "alpha", protocol::MAX_ALPHA, " component units")
+}
+
+fn parse_gain(text: &str) -> Result<KeyValue, String> {
+    bounded(text, "gain", protocol::MAX_GAIN, "")
+}
+
+/// The live controls' bounds hold offline too: past them an edit leaves any face.
+fn bounded(text: &str, what: &str, max: f32, unit: &str) -> Result<KeyValue, String> {
+    let kv = parse_key_value(text)?;
+    if kv.value.abs() > f64::from(max) {
+        let given = text.split_once('=').map_or(text, |(_, v)| v.trim());
+        return Err(format!("{what} {given} is outside -{max}..{max}{unit}"));
+    }
+    Ok(kv)
 }
 
 fn parse_key_value(text: &str) -> Result<KeyValue, String> {

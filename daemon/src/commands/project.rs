@@ -8,6 +8,7 @@ use crate::offline;
 
 pub(crate) fn run(args: &ProjectArgs) -> Result<()> {
     offline::output::check_out(&args.out, &[&args.file, &args.model], args.force)?;
+    offline::output::check_out_format(&args.out, "csv")?;
     let model = offline::load_model(&args.model)?;
     let mut progress = super::progress::for_stderr("project");
     let input = (args.file.as_path(), offline::takes::input_limit());

@@ -135,6 +135,7 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     let mut inputs: Vec<&Path> = paths.iter().map(PathBuf::as_path).collect();
     inputs.extend(args.manifest.as_deref());
     offline::output::check_out(&args.out, &inputs, args.force)?;
+    offline::output::check_out_format(&args.out, "json")?;
     let stream = StreamOptions {
         threads: args.threads,
         always_stream: args.stream,

@@ -55,6 +55,26 @@ pub fn check_out(out: &Path, inputs: &[&Path], force: bool) -> Result<()> {
     Ok(())
 }
 
+/// Checks that `out` does not name a take format the command does not write (`writes`: what
+/// it writes, as a file extension): a model or a component CSV in a file named `.c3d` would
+/// read back as a broken take.
+///
+/// # Errors
+/// A [`UsageError`] naming the path and the extension to use.
+pub fn check_out_format(out: &Path, writes: &str) -> Result<()> {
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some(take @ ("c3d" | "trc" | "csv")) if take != writes => Err(UsageError(format!(
+            "{} names a .{take} take, but this command writes .{writes}; name the output .{writes}",
+            out.display()
+        ))
+        .into()),
+        _ => Ok(()),
+    }
+}
+
 /// Checks that the folder `out` is empty or absent unless `force` (its files would be
 /// replaced).
 ///
@@ -92,6 +112,13 @@ mod tests {
         assert!(e.to_string().contains("--force"), "{e}");
         assert!(check_out(&take, &[], true).is_ok());
         assert!(check_out(&dir.path().join("new.trc"), &[&take], false).is_ok());
+        assert!(check_out_format(Path::new("m.json"), "json").is_ok());
+        assert!(check_out_format(Path::new("m.model"), "json").is_ok());
+        assert!(check_out_format(Path::new("u.CSV"), "csv").is_ok());
+        let e = check_out_format(Path::new("u.c3d"), "csv").expect_err("a take format");
+        assert!(e.to_string().contains("name the output .csv"), "{e}");
+        assert!(check_out_format(Path::new("m.trc"), "json").is_err());
+        assert!(check_out_format(Path::new("m.csv"), "json").is_err());
         let e = check_out(dir.path(), &[&take], true).expect_err("a folder");
         assert!(e.to_string().contains("is a folder"), "{e}");
     }
