@@ -406,6 +406,26 @@ fn bad_params_are_refused_with_the_bad_value() {
     })
     .expect_err("bad name");
     assert!(err.to_string().contains("a/b"));
+    // Sizes that would fill memory before a take is written are refused up front.
+    for (p, needle) in [
+        (
+            SynthParams {
+                rate_hz: 1e7,
+                ..params(1)
+            },
+            "at most 2000 Hz, got 10000000",
+        ),
+        (
+            SynthParams {
+                sentences: 1_000_000,
+                ..params(1)
+            },
+            "at most 10000 sentences",
+        ),
+    ] {
+        let err = Synth::new(p).expect_err("too large");
+        assert!(err.to_string().contains(needle), "{err}");
+    }
 }
 
 #[test]

@@ -5,12 +5,15 @@ use std::path::PathBuf;
 /// Why the generator cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum SynthError {
-    /// The frame rate is not positive and finite.
-    #[error("rate must be positive and finite, got {0}")]
+    /// The frame rate is not positive and finite, or past [`super::MAX_RATE_HZ`].
+    #[error("rate must be above 0 and at most {max} Hz, got {0}", max = super::MAX_RATE_HZ)]
     BadRate(f64),
     /// No sentences were requested.
     #[error("need at least one sentence, got 0")]
     NoSentences,
+    /// More sentences than [`super::MAX_SENTENCES`].
+    #[error("at most {max} sentences (about 26 hours of takes), got {0}", max = super::MAX_SENTENCES)]
+    TooManySentences(usize),
     /// No emotions were given.
     #[error("need at least one emotion")]
     NoEmotions,

@@ -72,6 +72,13 @@ use seeds::{name_key, sub_rng, sub_seed, Stream};
 pub const DEFAULT_RATE_HZ: f64 = 120.0;
 /// Default number of sentences.
 pub const DEFAULT_SENTENCES: usize = 8;
+/// Most sentences: 10,000 sentences in three emotions are about 26 hours at 120 Hz (the
+/// 4-hour benchmark session has 1,504). Past it the sentences alone would fill memory
+/// before a take is written.
+pub const MAX_SENTENCES: usize = 10_000;
+/// Highest frame rate, Hz: past what facial capture runs at (optical systems to about 1 kHz).
+/// A take's frames are rendered in memory, so a rate of 1e7 Hz would ask for tens of GB.
+pub const MAX_RATE_HZ: f64 = 2_000.0;
 /// Default emotions.
 pub const DEFAULT_EMOTIONS: [&str; 3] = ["neutral", "happy", "frustrated"];
 /// Default number of emotion directions: one, the smile/frown line.
@@ -122,11 +129,14 @@ impl SynthParams {
     /// The first bad knob: rate, sentence count, emotion list, emotion directions, explicit
     /// points.
     pub fn validate(&self) -> Result<(), SynthError> {
-        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= MAX_RATE_HZ) {
             return Err(SynthError::BadRate(self.rate_hz));
         }
         if self.sentences == 0 {
             return Err(SynthError::NoSentences);
+        }
+        if self.sentences > MAX_SENTENCES {
+            return Err(SynthError::TooManySentences(self.sentences));
         }
         self.validate_emotions()?;
         SourceLayout::new(self.emotion_dims)?;
