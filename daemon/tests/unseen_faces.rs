@@ -324,6 +324,22 @@ fn issue12_too_many_components_on_a_small_session_warn_of_noise_and_instability(
     let m = IcaModel::load(std::fs::File::open(&model).expect("model")).expect("valid");
     assert!(m.quality().has(WarningKind::KeepsNoise), "{out}");
     assert!(m.quality().has(WarningKind::UnstableComponent), "{out}");
+    // Named as components (c3), not as a bare number that reads as a count, and never at the
+    // bound they are below.
+    let unstable = out
+        .lines()
+        .find(|l| l.contains("not found again"))
+        .expect("the warning");
+    let listed = unstable.split("below 0.9): ").nth(1).expect("a list");
+    for item in listed.split(", ") {
+        let (name, value) = item.split_once(" (").expect("c<k> (<corr>)");
+        assert!(
+            name.starts_with('c') && name[1..].parse::<usize>().is_ok(),
+            "{item}"
+        );
+        let v: f64 = value.trim_end_matches(')').parse().expect("a number");
+        assert!(v < 0.9, "{item}");
+    }
     assert!(out.contains("at the noise floor"), "{out}");
 }
 

@@ -191,7 +191,8 @@ fn warn_components(q: &mut ModelQuality, model: &IcaModel) {
         .iter()
         .enumerate()
         .filter(|(_, &s)| s < UNSTABLE_BELOW)
-        .map(|(i, s)| format!("{i} ({s:.2})"))
+        // Rounded down, so a value just under the bound never reads as the bound.
+        .map(|(i, s)| format!("c{i} ({:.2})", (s * 100.0).floor() / 100.0))
         .collect();
     if !unstable.is_empty() {
         q.warn(
