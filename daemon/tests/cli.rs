@@ -383,3 +383,43 @@ fn a_head_reference_asked_for_and_not_used_is_a_warning_and_a_regions_file_is_no
         "in the model's warnings"
     );
 }
+
+/// What `train` says it filled is what `info` says is missing, plus the glitches it dropped,
+/// counted the same way: marker samples (Facial-Sing, a capture emoshift did not make).
+#[test]
+fn train_counts_gaps_in_the_marker_samples_info_counts() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let take =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../replay/tests/fixtures/Facial-Sing.c3d");
+    let info: serde_json::Value =
+        serde_json::from_str(&ok(&["info", p(&take), "--json"])).expect("info json");
+    let out = ok(&["train", p(&take), "--out", p(&dir.path().join("m.json"))]);
+    let number_after = |prefix: &str| -> usize {
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no {prefix:?} in {out}"));
+        line[prefix.len()..]
+            .split_whitespace()
+            .next()
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no count in {line:?}"))
+    };
+    let excluded: Vec<&str> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("excluded marker "))
+        .filter_map(|l| l.split(':').next())
+        .collect();
+    assert_eq!(excluded, ["Unlabeled1"], "{out}");
+    let missing: u64 = info["marker_list"]
+        .as_array()
+        .expect("markers")
+        .iter()
+        .filter(|m| !excluded.contains(&m["label"].as_str().expect("label")))
+        .map(|m| m["missing"].as_u64().expect("count"))
+        .sum();
+    let glitches = number_after("glitches: ");
+    let gaps = number_after("gaps: ");
+    assert!(glitches > 0 && missing > 0, "{out}");
+    assert_eq!(gaps as u64, missing + glitches as u64, "{out}");
+}

@@ -190,8 +190,9 @@ fn save_and_print(
     print_preparation(&data)?;
     if gaps.frames > 0 || gaps.frames_left_out > 0 {
         crate::out!(
-            "gaps: {} samples in {} frames filled from the visible markers (PCA, EM); {} frames missing more than half their markers left out",
-            gaps.samples,
+            "gaps: {} marker samples in {} frames filled from the visible markers (PCA, EM); {} frames missing more than half their markers left out",
+            // Counted per coordinate; a marker's gap is its three.
+            gaps.samples / 3,
             gaps.frames,
             gaps.frames_left_out
         );
