@@ -423,3 +423,27 @@ fn train_counts_gaps_in_the_marker_samples_info_counts() {
     assert!(glitches > 0 && missing > 0, "{out}");
     assert_eq!(gaps as u64, missing + glitches as u64, "{out}");
 }
+
+/// A named head reference that cannot be used says who named it and why: a marker the take
+/// lacks, or one training left out for being missing (Facial-Sing's `Unlabeled1`), and not
+/// a regions file, which none was given.
+#[test]
+fn a_head_reference_that_cannot_be_used_names_the_flag_and_the_reason() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let take =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../replay/tests/fixtures/Facial-Sing.c3d");
+    let out = dir.path().join("m.json");
+    for (head, needle) in [
+        ("Nope", "--head-reference names marker \"Nope\", which the take does not have"),
+        (
+            "Unlabeled1,root-1,root-2",
+            "--head-reference names marker \"Unlabeled1\", which training left out: it is missing in 98.8 % of the frames",
+        ),
+        ("zz*", "--head-reference matches no marker"),
+    ] {
+        let args = ["train", p(&take), "--head-reference", head, "--out", p(&out)];
+        fails(&args, needle);
+        let err = String::from_utf8_lossy(&run(&args).stderr).into_owned();
+        assert!(!err.contains("region"), "{err}");
+    }
+}

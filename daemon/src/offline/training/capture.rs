@@ -32,6 +32,7 @@ pub(super) struct Learned {
 pub(super) fn learn(
     frames: &[ModelFrames],
     labels: &[String],
+    excluded: &[(String, f64)],
     rate_hz: f64,
     options: &PrepOptions,
 ) -> Result<Learned> {
@@ -59,7 +60,7 @@ pub(super) fn learn(
         markers: n,
         takes: &ranges,
     };
-    let decision = head::decide(&options.head, labels, &raw)?;
+    let decision = head::decide(&options.head, labels, excluded, &raw)?;
     let reference = decision.markers;
     let head = match reference.len() {
         0 => None,

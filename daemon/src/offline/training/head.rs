@@ -18,7 +18,7 @@ use ica_core::stabilise::{
     assess_named, choose, search_reference, Choice, GroupAssessment, MarkerFrames, SearchParams,
     MIN_MOTION_MM, MOTION_FACTOR,
 };
-use replay::session::Regions;
+use replay::session::{Regions, SessionError};
 
 /// Common names of rigid head markers: Vicon Plug-in Gait's head band, and head, hat, helmet
 /// and head-rig markers of other setups.
@@ -66,13 +66,16 @@ pub struct HeadDecision {
     pub report: HeadReport,
 }
 
-/// Decides the head reference. See the module docs.
+/// Decides the head reference among the kept markers `labels` (`excluded`: the markers left
+/// out of training and the share of frames they miss, which named references are checked
+/// against). See the module docs.
 ///
 /// # Errors
-/// Named markers that do not resolve, or fewer than three of them.
+/// Named markers that do not resolve (or were left out), or fewer than three of them.
 pub fn decide(
     choice: &HeadChoice,
     labels: &[String],
+    excluded: &[(String, f64)],
     frames: &MarkerFrames<'_>,
 ) -> Result<HeadDecision> {
     match choice {
@@ -88,7 +91,12 @@ pub fn decide(
             patterns,
             requested,
         } => {
-            let markers = resolve_named(patterns, labels)?;
+            let from = if *requested {
+                "--head-reference"
+            } else {
+                "the regions file's head_reference"
+            };
+            let markers = resolve_named(patterns, labels, excluded, from)?;
             let mut decision = from_named("named", markers, labels, frames);
             decision.report.requested = *requested;
             Ok(decision)
@@ -103,13 +111,33 @@ pub fn decide(
     }
 }
 
-fn resolve_named(patterns: &[String], labels: &[String]) -> Result<Vec<usize>> {
+/// The markers `patterns` name (`from`: who named them, for the errors).
+fn resolve_named(
+    patterns: &[String],
+    labels: &[String],
+    excluded: &[(String, f64)],
+    from: &str,
+) -> Result<Vec<usize>> {
+    if let Some((label, share)) = excluded.iter().find(|(l, _)| patterns.contains(l)) {
+        bail!(
+            "{from} names marker {label:?}, which training left out: it is missing in {:.1} % of the frames",
+            100.0 * share
+        );
+    }
     let regions = Regions {
         regions: [("head_reference".to_string(), patterns.to_vec())].into(),
     };
     let idx = regions
         .resolve(labels)
-        .map_err(|e| anyhow!("head reference: {e}"))?
+        .map_err(|e| match e {
+            SessionError::UnknownLabel { label, hint, .. } => {
+                anyhow!("{from} names marker {label:?}, which the take does not have{hint}")
+            }
+            SessionError::EmptyRegion { patterns, hint, .. } => {
+                anyhow!("{from} matches no marker (patterns {patterns:?}){hint}")
+            }
+            e => anyhow!("{from}: {e}"),
+        })?
         .remove("head_reference")
         .unwrap_or_default();
     if idx.len() < 3 {

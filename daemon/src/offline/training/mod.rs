@@ -182,7 +182,7 @@ pub fn prepare(takes: &[LoadedTake], options: &PrepOptions) -> Result<PreparedDa
         ranges.push(start..start + f.frames());
         start += f.frames();
     }
-    let learned = capture::learn(&frames, &labels, rate_hz, options)?;
+    let learned = capture::learn(&frames, &labels, &excluded, rate_hz, options)?;
     let (capture, reference, mut head_report) = (learned.capture, learned.reference, learned.head);
     let (samples, marker_missing, glitches, residuals_mm) =
         run_prep(&frames, n, rate_hz, &capture)?;

@@ -142,6 +142,7 @@ fn streamed(
         capture::learn(
             &scanned.sample,
             &scanned.labels,
+            &scanned.excluded,
             scanned.rate_hz,
             &options.prep,
         )
