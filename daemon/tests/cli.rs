@@ -447,3 +447,32 @@ fn a_head_reference_that_cannot_be_used_names_the_flag_and_the_reason() {
         assert!(!err.contains("region"), "{err}");
     }
 }
+
+/// A corrupt parameter byte that makes c3dio panic (one zeroed byte of a label in a c3d.org
+/// sample): the reader catches the panic and decodes the file itself, and the user sees the
+/// take, not a panic message and a backtrace.
+#[test]
+fn a_c3dio_panic_on_a_corrupt_file_stays_quiet_and_the_take_reads() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("../replay/tests/fixtures/Eb015pi.c3d");
+    let mut bytes = std::fs::read(sample).expect("fixture");
+    bytes[3352] = 0;
+    let (take, info) = replay::c3d::read_with_info(&bytes).expect("our decoder reads it");
+    assert_eq!(
+        info.c3dio_error.as_deref(),
+        Some("c3dio panicked"),
+        "the corruption no longer makes c3dio panic: pick another byte"
+    );
+    assert!(!replay::c3d::catching_c3dio_panic());
+    let corrupt = dir.path().join("corrupt.c3d");
+    std::fs::write(&corrupt, &bytes).expect("write");
+    let out = run(&["info", p(&corrupt)]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(&format!("frames:   {} ", take.n_frames())),
+        "{text}"
+    );
+}

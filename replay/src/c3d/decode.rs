@@ -1,6 +1,7 @@
 //! The 3D samples: decoded by c3dio where it can, by our own decoder otherwise, and the missing
 //! mask from the raw residual words either way.
 
+use std::cell::Cell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use c3dio::C3d;
@@ -72,6 +73,17 @@ fn residual_word(bytes: &[u8], at: usize, l: &Layout) -> i32 {
     }
 }
 
+thread_local! {
+    static CATCHING: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Whether this thread is inside the c3dio call whose panics [`via_c3dio`] catches and
+/// reports as an error: a binary's panic hook can stay quiet for those (the file is then read
+/// by emoshift's own decoder alone), and speak for every other.
+pub fn catching_c3dio_panic() -> bool {
+    CATCHING.with(Cell::get)
+}
+
 /// Decodes through c3dio: `Ok` with the values when c3dio reads the file with the expected shape,
 /// `Err` with c3dio's complaint otherwise (a panic inside c3dio included). Residual signs are not
 /// taken from c3dio: it reads the residual byte as signed, which flags large valid residuals as
@@ -88,10 +100,12 @@ pub fn via_c3dio(bytes: &[u8], l: &Layout, h: &Header) -> Result<Vec<f32>, Strin
     }
     let param_block = h.parameter_block;
     let canonical = canonical_layout(bytes, l, param_block)?;
+    CATCHING.with(|c| c.set(true));
     let parsed = catch_unwind(AssertUnwindSafe(|| {
         C3d::from_bytes(&canonical).map_err(|e| format!("{e:?}"))
-    }))
-    .map_err(|_| "c3dio panicked".to_string())??;
+    }));
+    CATCHING.with(|c| c.set(false));
+    let parsed = parsed.map_err(|_| "c3dio panicked".to_string())??;
     let pts = &parsed.points;
     if pts.cols() != l.points || pts.rows() != l.frames {
         return Err(format!(

@@ -22,7 +22,7 @@ pub(crate) mod write;
 use std::io::Read;
 
 pub use binary::Processor;
-pub use decode::Decoder;
+pub use decode::{catching_c3dio_panic, Decoder};
 pub use error::{C3dError, C3dLimitError};
 pub use frames::C3dBlocks;
 pub use write::write;
