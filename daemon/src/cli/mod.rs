@@ -32,7 +32,13 @@ pub fn one_line(error: &clap::Error) -> String {
 pub struct Cli {
     /// Largest input file read (takes, models, manifests), MB; devices and FIFOs are refused
     /// whatever their size.
-    #[arg(long, global = true, default_value_t = 8192, value_name = "MB")]
+    #[arg(
+        long,
+        global = true,
+        default_value_t = 8192,
+        value_name = "MB",
+        value_parser = values::input_limit_mb
+    )]
     pub max_input_mb: u64,
     /// What to do.
     #[command(subcommand)]

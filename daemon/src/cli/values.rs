@@ -48,6 +48,15 @@ pub(super) fn share(text: &str) -> Result<f64, String> {
     }
 }
 
+/// An input limit in MB: a whole number of at least 1 (0 would refuse every file).
+pub(super) fn input_limit_mb(text: &str) -> Result<u64, String> {
+    match text.trim().parse::<u64>() {
+        Ok(0) => Err("0 MB would refuse every file: give at least 1".into()),
+        Ok(mb) => Ok(mb),
+        Err(_) => Err(format!("{text:?} is not a whole number of MB")),
+    }
+}
+
 /// Any finite number.
 pub(super) fn finite(text: &str) -> Result<f64, String> {
     number(text)
@@ -62,6 +71,10 @@ mod tests {
         assert_eq!(positive("120"), Ok(120.0));
         for bad in ["0", "-1", "nan", "inf", "fast", ""] {
             assert!(positive(bad).is_err(), "{bad}");
+        }
+        assert_eq!(input_limit_mb("8192"), Ok(8192));
+        for bad in ["0", "-1", "1.5", "lots"] {
+            assert!(input_limit_mb(bad).is_err(), "{bad}");
         }
         assert_eq!(non_negative("0"), Ok(0.0));
         assert!(non_negative("-0.5").is_err());
