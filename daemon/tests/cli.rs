@@ -476,3 +476,22 @@ fn a_c3dio_panic_on_a_corrupt_file_stays_quiet_and_the_take_reads() {
         "{text}"
     );
 }
+
+/// Analog data (16 channels in a c3d.org sample) is not read: `info` says it is there, and
+/// `convert` says the output leaves it out; a take without any says nothing.
+#[test]
+fn analog_channels_left_out_are_said_so() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../replay/tests/fixtures");
+    let with = fixtures.join("Eb015pi.c3d");
+    assert!(ok(&["info", p(&with)]).contains("analog:   64 samples per frame (not read"));
+    let out = ok(&["convert", p(&with), p(&dir.path().join("a.trc"))]);
+    assert!(
+        out.contains("has analog data (64 samples per frame), which emoshift does not read"),
+        "{out}"
+    );
+    let without = fixtures.join("Facial-Sing.c3d");
+    assert!(!ok(&["info", p(&without)]).contains("analog"));
+    let out = ok(&["convert", p(&without), p(&dir.path().join("f.trc"))]);
+    assert!(!out.contains("warning"), "{out}");
+}

@@ -9,6 +9,9 @@ pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
     let take = crate::offline::load_take(&args.input)?;
     replay::save(&args.output, &take).with_context(|| format!("{}", args.output.display()))?;
     let gaps: usize = take.missing.iter().filter(|&&m| m).count();
+    if let Some(note) = crate::offline::takes::analog_left_out(&args.input) {
+        crate::out!("warning: {} {note}", args.input.display());
+    }
     crate::out!(
         "wrote {}: {} markers, {} frames at {} Hz, {} missing samples",
         args.output.display(),

@@ -53,7 +53,8 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
         let s = super::progress::settle(progress.as_mut(), done).map_err(usage)?;
         (s.frames, s.notices)
     };
-    for notice in &notices {
+    let unread = offline::takes::analog_left_out(&args.file);
+    for notice in notices.iter().chain(&unread) {
         crate::out!("warning: {} {notice}", args.file.display());
     }
     crate::out!("edited {frames} frames -> {}", args.out.display());

@@ -16,6 +16,9 @@ struct Info<'a> {
     duration_s: f64,
     source_units: &'static str,
     missing_samples: usize,
+    /// Analog samples per frame (C3D), which emoshift does not read.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    analog_per_frame: Option<usize>,
     marker_list: Vec<MarkerInfo<'a>>,
 }
 
@@ -39,6 +42,7 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
         duration_s: frames as f64 / take.rate_hz,
         source_units: take.source_units.as_str(),
         missing_samples: per_marker.iter().sum(),
+        analog_per_frame: crate::offline::takes::analog_samples(&args.file),
         marker_list: take
             .labels
             .iter()
@@ -73,6 +77,9 @@ fn print_text(info: &Info<'_>) -> Result<()> {
         100.0 * info.missing_samples as f64 / total as f64
     };
     crate::out!("missing:  {} samples ({pct:.2} %)", info.missing_samples);
+    if let Some(n) = info.analog_per_frame {
+        crate::out!("analog:   {n} samples per frame (not read: emoshift reads the markers)");
+    }
     let width = info
         .marker_list
         .iter()

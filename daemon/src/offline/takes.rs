@@ -188,6 +188,32 @@ pub fn take_notices(model: &IcaModel, take: (&[String], f64), map: &LabelMap) ->
     notices
 }
 
+/// Analog samples per frame of a C3D take (force plates, EMG, audio), which emoshift does not
+/// read and its outputs leave out. `None` for other files, unreadable ones (their reading
+/// reports them) and C3Ds without analog data.
+pub fn analog_samples(path: &Path) -> Option<usize> {
+    use std::io::Read as _;
+    if replay::Format::from_path(path) != Some(replay::Format::C3d) {
+        return None;
+    }
+    // The header and the parameter section's first block, wherever the header puts it.
+    let mut head = Vec::new();
+    let file = std::fs::File::open(path).ok()?;
+    file.take(256 * 512).read_to_end(&mut head).ok()?;
+    let blocks = usize::from(*head.first()?);
+    head.truncate(blocks.max(2) * 512);
+    replay::c3d::analog_per_frame(&head).ok().filter(|&n| n > 0)
+}
+
+/// The warning for an output written from a take with [`analog_samples`].
+pub fn analog_left_out(path: &Path) -> Option<String> {
+    analog_samples(path).map(|n| {
+        format!(
+            "has analog data ({n} samples per frame), which emoshift does not read: the output keeps the markers only"
+        )
+    })
+}
+
 /// Matches a take to a model by label.
 ///
 /// # Errors

@@ -108,6 +108,15 @@ pub fn read_time(bytes: &[u8]) -> Result<crate::record::RecordTime, ReadError> {
     })
 }
 
+/// Analog samples per 3D frame, all channels together, from the first bytes of a C3D file
+/// (through the parameter section's first block): what emoshift does not read.
+///
+/// # Errors
+/// Bytes that are not the start of a C3D file (see [`read`]).
+pub fn analog_per_frame(head: &[u8]) -> Result<usize, C3dError> {
+    binary::parse_header(head).map(|(_, h)| usize::from(h.analog_per_frame))
+}
+
 /// Reads a C3D take from bytes and reports how it was decoded.
 ///
 /// # Errors
