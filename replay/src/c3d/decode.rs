@@ -77,9 +77,10 @@ thread_local! {
     static CATCHING: Cell<bool> = const { Cell::new(false) };
 }
 
-/// Whether this thread is inside the c3dio call whose panics [`via_c3dio`] catches and
-/// reports as an error: a binary's panic hook can stay quiet for those (the file is then read
-/// by emoshift's own decoder alone), and speak for every other.
+/// Whether this thread is inside the c3dio call whose panics the C3D reader catches and
+/// reports as an error ([`super::C3dInfo::c3dio_error`]): a binary's panic hook can stay quiet
+/// for those (the file is then read by emoshift's own decoder alone), and speak for every
+/// other.
 pub fn catching_c3dio_panic() -> bool {
     CATCHING.with(Cell::get)
 }
