@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
-    // A corrupt C3D can make c3dio panic; the reader catches that, says so in its notes and
-    // decodes the file itself, so the panic's message and backtrace are not the user's news.
+    // A corrupt C3D can make c3dio panic; the reader catches that and decodes the file with
+    // emoshift's own decoder, so the panic's message and backtrace are not the user's news.
     let speak = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         if !replay::c3d::catching_c3dio_panic() {
