@@ -169,6 +169,11 @@ impl Streams {
             .retain(|k, _| !(k.source == source && k.layout_id == layout_id));
     }
 
+    /// Drops every stream of one source (it went quiet).
+    pub fn forget_source(&mut self, source: SocketAddr) {
+        self.map.retain(|k, _| k.source != source);
+    }
+
     /// Every stream, to read.
     pub fn iter(&self) -> impl Iterator<Item = (&StreamKey, &Stream)> {
         self.map.iter()

@@ -6,6 +6,7 @@
 //! [`Pipeline::set_model`] between datagrams (a frame boundary).
 
 use core::net::SocketAddr;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 use ica_core::model::IcaModel;
@@ -72,6 +73,12 @@ fn describe_mismatch(streams: &[(String, Vec<String>)]) -> String {
 
 /// Sources tracked for labels, and streams, at most (bounds memory against spoofed senders).
 pub const MAX_SOURCES: usize = 64;
+/// Sweeps ([`Pipeline::forget_quiet_sources`]) an OSC source may stay silent through: at the
+/// next it is forgotten (its layouts and streams go, and its slot among [`MAX_SOURCES`] is free
+/// again). A source that comes back is taken again from its next labels (sent every second).
+pub const QUIET_SWEEPS: u64 = 3;
+/// How often the service sweeps, seconds (for the refusal's words; the shell owns the clock).
+pub const SWEEP_SECONDS: u64 = 10;
 
 /// One processed frame, borrowed from the pipeline's buffers.
 #[derive(Debug)]
@@ -152,6 +159,10 @@ pub struct Pipeline {
     wanted: ProfileMask,
     /// The last refusal the source should hear, taken by the shell after each datagram.
     refusal: Option<Refusal>,
+    /// Per OSC source the layout book holds, the sweep it was last heard in.
+    heard: HashMap<SocketAddr, u64>,
+    /// Sweeps so far.
+    sweeps: u64,
     /// Counters, read by the caller after each batch.
     pub counters: Counters,
 }
@@ -171,12 +182,36 @@ impl Pipeline {
             outputs: Outputs::new(config.max_markers),
             wanted: profile_bit(Profile::Compact),
             refusal: None,
+            heard: HashMap::with_capacity(MAX_SOURCES),
+            sweeps: 0,
             counters: Counters::default(),
             template,
             model,
             performers,
             config,
         }
+    }
+
+    /// Forgets the OSC sources heard last before the last [`QUIET_SWEEPS`] calls (the shell
+    /// calls this every [`SWEEP_SECONDS`]): their layouts, their streams and their slot. Without it a
+    /// stage whose sources restart from new ports (a bridge or Motive restarted) fills the
+    /// [`MAX_SOURCES`] slots with dead sources, and the next one is never taken. Returns the
+    /// sources forgotten.
+    pub fn forget_quiet_sources(&mut self) -> Vec<SocketAddr> {
+        self.sweeps += 1;
+        let sweeps = self.sweeps;
+        let quiet: Vec<SocketAddr> = self
+            .heard
+            .iter()
+            .filter(|&(_, &last)| last + QUIET_SWEEPS < sweeps)
+            .map(|(&peer, _)| peer)
+            .collect();
+        for peer in &quiet {
+            self.heard.remove(peer);
+            self.layouts.forget(peer);
+            self.streams.forget_source(*peer);
+        }
+        quiet
     }
 
     /// The refusal of the last datagram, if it was refused with a reason for its source.
@@ -304,11 +339,22 @@ impl Pipeline {
             Ok(labels) => {
                 let id = labels.layout_id;
                 self.counters.labels_in += 1;
-                if let LayoutChange::Replaced | LayoutChange::Added =
-                    self.layouts.handle_labels(&peer, labels)
-                {
-                    self.streams.forget(peer, id);
+                match self.layouts.handle_labels(&peer, labels) {
+                    LayoutChange::Replaced | LayoutChange::Added => {
+                        self.streams.forget(peer, id);
+                    }
+                    LayoutChange::Unchanged => {}
+                    LayoutChange::Rejected => {
+                        self.counters.labels_refused += 1;
+                        let why = format!(
+                            "the daemon already takes {MAX_SOURCES} sources; a source silent for {} s is forgotten, which makes room",
+                            QUIET_SWEEPS * SWEEP_SECONDS
+                        );
+                        self.refusal = Some(Refusal { to: peer, why });
+                        return;
+                    }
                 }
+                self.heard.insert(peer, self.sweeps);
             }
             Err(e @ DecodeError::DuplicateLabel { index }) => {
                 // A layout whose names repeat maps no frame; the last good one stays.
@@ -334,6 +380,8 @@ impl Pipeline {
         let Some(labels) = self.layouts.layout_for(&peer, header.marker_count) else {
             return self.counters.dropped_no_layout += 1;
         };
+        // An existing key: no allocation (the map holds at most MAX_SOURCES, reserved).
+        self.heard.insert(peer, self.sweeps);
         let key = StreamKey {
             source: peer,
             layout_id: labels.layout_id,

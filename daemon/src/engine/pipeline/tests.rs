@@ -232,3 +232,54 @@ fn the_source_timecode_travels_with_its_frame() {
         Some("00:01:00;02.0")
     );
 }
+
+/// Sources that went quiet give their slot back: a stage whose bridge restarts from a new port
+/// each time must not run out of sources for good (it did after 64 such restarts).
+#[test]
+fn quiet_sources_are_forgotten_and_their_slots_taken_again() {
+    let model = Arc::new(random_model(MARKERS, 4, 9));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let mut xyz = vec![0.0; MARKERS * 3];
+    frame_into(&model, 0, &mut xyz);
+    let labels = labels_datagram(&model, false);
+    let source =
+        |i: usize| -> SocketAddr { format!("127.0.0.2:{}", 6000 + i).parse().expect("addr") };
+    let mut out = 0;
+    let mut send = |p: &mut Pipeline, who: SocketAddr, n: i32| {
+        p.handle_datagram(who, &labels, &mut |_| {});
+        p.handle_datagram(who, &frame_datagram(&xyz, n), &mut |_| out += 1);
+    };
+    for i in 0..MAX_SOURCES {
+        send(&mut p, source(i), 1);
+    }
+    assert_eq!(p.stream_count(), MAX_SOURCES);
+    // One more is refused with a reason, and its frames have no layout.
+    let late = source(MAX_SOURCES);
+    send(&mut p, late, 1);
+    let refusal = p.take_refusal().expect("told why");
+    assert_eq!(refusal.to, late);
+    assert!(refusal.why.contains("64 sources"), "{}", refusal.why);
+    assert_eq!(p.counters.dropped_no_layout, 1);
+    // Source 0 keeps sending; the others are silent through the sweeps.
+    for sweep in 0..QUIET_SWEEPS {
+        assert!(
+            p.forget_quiet_sources().is_empty(),
+            "sweep {sweep}: forgotten too soon"
+        );
+        send(&mut p, source(0), 2 + sweep as i32);
+    }
+    let gone = p.forget_quiet_sources();
+    assert_eq!(gone.len(), MAX_SOURCES - 1);
+    assert!(!gone.contains(&source(0)));
+    assert_eq!(p.stream_count(), 1);
+    // The late source is taken now, and its frames go out.
+    let before = p.counters.frames_out;
+    send(&mut p, late, 1);
+    assert!(p.take_refusal().is_none());
+    assert_eq!(p.counters.frames_out, before + 1);
+    assert_eq!(p.stream_count(), 2);
+    // A forgotten source that comes back is taken again from its labels.
+    send(&mut p, source(5), 1);
+    assert_eq!(p.stream_count(), 3);
+    assert!(out > MAX_SOURCES);
+}

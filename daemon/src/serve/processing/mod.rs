@@ -20,7 +20,7 @@ use super::monitor::Feed;
 use super::record::{finish_recording, Recording};
 use super::sender::Fanout;
 use super::stats::{Stats, SubscriberStatus};
-use crate::engine::pipeline::{Emitted, Pipeline, Refusal as Refused};
+use crate::engine::pipeline::{Emitted, Pipeline, Refusal as Refused, QUIET_SWEEPS, SWEEP_SECONDS};
 
 /// The processing thread merges its counters and histograms into the shared [`Stats`] (a
 /// lock, a histogram add and reset: tens of µs) only between bursts, at most this often: with
@@ -98,11 +98,16 @@ pub(crate) struct Processing {
     /// The frame socket, for refusals a source should hear, and when each source last heard one.
     replies: Option<std::net::UdpSocket>,
     told: HashMap<SocketAddr, Instant>,
+    /// When a refusal was last logged, and the refusals not logged since (many sources at
+    /// once, spoofed or not, log one line a second).
+    refusals_logged: (Option<Instant>, u64),
     recording: Option<Recording>,
     /// Recordings being closed on their own threads.
     closing: Vec<std::thread::JoinHandle<()>>,
     /// When the counters were last merged into the shared stats.
     last_merge: Instant,
+    /// When quiet sources were last swept ([`Pipeline::forget_quiet_sources`]).
+    last_sweep: Instant,
     processed_us: hdrhistogram::Histogram<u64>,
     /// Per stream id, capture → processed (see [`super::latency`]).
     latency: super::latency::StreamLatency,
@@ -135,9 +140,11 @@ impl Processing {
             not_allowed: shared.not_allowed,
             replies: shared.replies,
             told: HashMap::new(),
+            refusals_logged: (None, 0),
             recording: None,
             closing: Vec::new(),
             last_merge: Instant::now(),
+            last_sweep: Instant::now(),
             processed_us: Stats::histogram(),
             latency: super::latency::StreamLatency::default(),
             monitor: shared.monitor,
@@ -306,7 +313,17 @@ impl Processing {
             self.told.retain(|_, t| now.duration_since(*t) < TELL_EVERY);
         }
         self.told.insert(refusal.to, now);
-        tracing::warn!(target: "emoshift", source = %refusal.to, why = %refusal.why, "datagram refused");
+        let (last, unlogged) = &mut self.refusals_logged;
+        if last.is_none_or(|t| now.duration_since(t) >= TELL_EVERY) {
+            if *unlogged > 0 {
+                tracing::warn!(target: "emoshift", source = %refusal.to, why = %refusal.why, others = *unlogged, "datagram refused (and others not logged since the last)");
+            } else {
+                tracing::warn!(target: "emoshift", source = %refusal.to, why = %refusal.why, "datagram refused");
+            }
+            (*last, *unlogged) = (Some(now), 0);
+        } else {
+            *unlogged += 1;
+        }
         let Some(socket) = &self.replies else { return };
         let mut out = Vec::with_capacity(256);
         protocol::encode_error_into(protocol::address::LABELS, &refusal.why, &mut out);
@@ -316,6 +333,23 @@ impl Processing {
     /// Between frames: subscriptions whose lease ended; recordings done closing.
     fn housekeeping(&mut self) {
         self.closing.retain(|h| !h.is_finished());
+        if self.last_sweep.elapsed() >= Duration::from_secs(SWEEP_SECONDS) {
+            self.last_sweep = Instant::now();
+            let gone = self.pipeline.forget_quiet_sources();
+            if !gone.is_empty() {
+                let mut list: Vec<String> = gone.iter().take(8).map(ToString::to_string).collect();
+                if gone.len() > 8 {
+                    list.push(format!("and {} more", gone.len() - 8));
+                }
+                tracing::info!(
+                    target: "emoshift",
+                    sources = %list.join(", "),
+                    "forgot {} silent for {} s or more",
+                    crate::commands::count(gone.len(), "source"),
+                    QUIET_SWEEPS * SWEEP_SECONDS
+                );
+            }
+        }
         if self.fanout.expire(Instant::now()) {
             self.pipeline.set_wanted(self.fanout.wanted());
         }
