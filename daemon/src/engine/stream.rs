@@ -16,6 +16,10 @@ use super::Counters;
 /// A backwards jump of more than this many frames is a restarted source (a looping replay, a
 /// restarted capture), not a late frame: the stream starts over instead of dropping it.
 pub const RESTART_FRAMES: i64 = 240;
+/// Older frames in a row, each the one after the last, that are a restarted source counting
+/// up again from a lower number (a capture restarted within [`RESTART_FRAMES`] of where it
+/// stopped), not late frames: late frames come one at a time between newer ones.
+pub const RESTART_RUN: u32 = 3;
 
 /// Where a frame number falls in a stream's order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -111,6 +115,8 @@ pub struct Stream {
     /// Frames since the labels last went out (0: not yet).
     frames_since_labels: u32,
     last_frame: Option<i32>,
+    /// Older frames in a row, each the one after the one before: `(count, last of them)`.
+    stale_run: (u32, i32),
     /// Frames taken in order (processed).
     pub frames: u64,
     /// Duplicate frame numbers dropped.
@@ -185,6 +191,7 @@ impl Stream {
             out: vec![0.0; n * 3],
             vmc: vmc_names(&model),
             last_frame: None,
+            stale_run: (0, 0),
             frames: 0,
             duplicates: 0,
             stale: 0,
@@ -360,7 +367,7 @@ impl Stream {
             return Order::Next { frames: 1 };
         };
         let delta = i64::from(frame_number) - i64::from(last);
-        let order = match delta {
+        let mut order = match delta {
             0 => Order::Duplicate,
             d if d < -RESTART_FRAMES => Order::Restart,
             d if d < 0 => Order::Stale,
@@ -368,6 +375,21 @@ impl Stream {
                 frames: u32::try_from(d).unwrap_or(u32::MAX),
             },
         };
+        if order == Order::Stale {
+            let (run, prev) = self.stale_run;
+            let run = if run > 0 && prev.checked_add(1) == Some(frame_number) {
+                run + 1
+            } else {
+                1
+            };
+            self.stale_run = (run, frame_number);
+            if run >= RESTART_RUN {
+                order = Order::Restart;
+            }
+        }
+        if order != Order::Stale {
+            self.stale_run = (0, 0);
+        }
         match order {
             Order::Duplicate => self.duplicates += 1,
             Order::Stale => self.stale += 1,
