@@ -386,7 +386,46 @@ impl Pipeline {
             source: peer,
             layout_id: labels.layout_id,
         };
+        let unmatched = self.counters.dropped_unmatched;
         run::frame_step(run::step!(self), key, (&labels.names, None), &header, emit);
+        if self.counters.dropped_unmatched > unmatched {
+            self.refusal = Some(Refusal {
+                to: peer,
+                why: self.why_no_stream(peer, header.marker_count),
+            });
+        }
+    }
+
+    /// Why a source's frame made no stream: the stream table is full, or its markers are none
+    /// of the model's.
+    fn why_no_stream(&self, peer: SocketAddr, marker_count: usize) -> String {
+        if self.streams.len() >= MAX_SOURCES {
+            return format!("the daemon already runs {MAX_SOURCES} streams");
+        }
+        let names = self
+            .layouts
+            .layout_for(&peer, marker_count)
+            .map(|l| l.names.as_slice())
+            .unwrap_or_default();
+        let shown: Vec<&str> = names.iter().take(4).map(String::as_str).collect();
+        let more = names.len().saturating_sub(shown.len());
+        format!(
+            "none of its {} markers ({}{}) is a marker of the model, whose markers start {}",
+            names.len(),
+            shown.join(", "),
+            if more > 0 {
+                format!(" and {more} more")
+            } else {
+                String::new()
+            },
+            self.model
+                .labels()
+                .iter()
+                .take(4)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
     }
 }
 

@@ -283,3 +283,35 @@ fn quiet_sources_are_forgotten_and_their_slots_taken_again() {
     assert_eq!(p.stream_count(), 3);
     assert!(out > MAX_SOURCES);
 }
+
+/// A source whose markers are none of the model's hears why its frames make no stream (it was
+/// dropped in silence, counted in `/status` only).
+#[test]
+fn a_source_with_none_of_the_models_markers_hears_why() {
+    let model = Arc::new(random_model(MARKERS, 4, 11));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let names: Vec<String> = (0..MARKERS).map(|i| format!("other{i}")).collect();
+    let mut labels = Vec::new();
+    encode_labels_into(
+        &Labels {
+            layout_id: 3,
+            names,
+        },
+        &mut labels,
+    )
+    .expect("valid labels");
+    let xyz = vec![1.0; MARKERS * 3];
+    p.handle_datagram(peer(), &labels, &mut |_| {});
+    assert!(p.take_refusal().is_none(), "labels alone are fine");
+    p.handle_datagram(peer(), &frame_datagram(&xyz, 1), &mut |_| {
+        panic!("no stream")
+    });
+    let refusal = p.take_refusal().expect("told why");
+    assert_eq!(refusal.to, peer());
+    assert!(
+        refusal.why.starts_with("none of its 12 markers (other0, other1, other2, other3 and 8 more) is a marker of the model"),
+        "{}",
+        refusal.why
+    );
+    assert_eq!((p.counters.dropped_unmatched, p.stream_count()), (1, 0));
+}
