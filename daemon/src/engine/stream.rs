@@ -322,6 +322,22 @@ impl Stream {
         let resynthesised =
             self.processor
                 .resynthesise(prepared.pose.as_ref(), &self.u, &mut self.out);
+        if prepared.status.held {
+            // Too few markers to estimate the face: what was seen goes out as received, the
+            // rest as missing, rather than the last estimate passed off as data.
+            for ((out, xyz), &gone) in self
+                .out
+                .chunks_exact_mut(3)
+                .zip(self.xyz.chunks_exact(3))
+                .zip(&self.missing)
+            {
+                if gone {
+                    out.fill(f32::NAN);
+                } else {
+                    out.copy_from_slice(xyz);
+                }
+            }
+        }
         if resynthesised.is_err()
             || output
                 .set_frame(header.frame_number, header.capture_time_us, &self.out)

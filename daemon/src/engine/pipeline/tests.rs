@@ -315,3 +315,42 @@ fn a_source_with_none_of_the_models_markers_hears_why() {
     );
     assert_eq!((p.counters.dropped_unmatched, p.stream_count()), (1, 0));
 }
+
+/// A frame with too few markers to estimate the face goes out as seen: the visible markers as
+/// received, the others missing, not the last estimate passed off as every marker present.
+#[test]
+fn a_frame_too_occluded_to_estimate_goes_out_as_seen() {
+    let model = Arc::new(random_model(MARKERS, 4, 13));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let mut xyz = vec![0.0; MARKERS * 3];
+    frame_into(&model, 0, &mut xyz);
+    // One marker seen: 3 channels for 4 components.
+    let mut one = vec![f32::NAN; MARKERS * 3];
+    one[6..9].copy_from_slice(&xyz[6..9]);
+    let none = vec![f32::NAN; MARKERS * 3];
+    let mut got = Vec::new();
+    for (n, frame) in [(1, &xyz), (2, &one), (3, &none), (4, &xyz)] {
+        p.handle_datagram(peer(), &labels_datagram(&model, false), &mut |_| {});
+        p.handle_datagram(peer(), &frame_datagram(frame, n), &mut |e| {
+            let msg = messages(e.compact, &protocol::Limits::default())
+                .expect("well-formed")
+                .find(|m| m.address == protocol::address::FRAME)
+                .expect("the frame");
+            let mut buf = FrameBuf::new();
+            decode_frame_into(msg.bytes, &mut buf).expect("valid frame");
+            got.push(buf);
+        });
+    }
+    assert_eq!(got.len(), 4);
+    let present = |b: &FrameBuf| (0..MARKERS).filter(|&i| !b.is_missing(i)).count();
+    assert_eq!(present(&got[0]), MARKERS);
+    assert_eq!(present(&got[1]), 1);
+    assert!(!got[1].is_missing(2));
+    assert_eq!(&got[1].positions()[6..9], &xyz[6..9]);
+    assert_eq!(present(&got[2]), 0);
+    assert_eq!(
+        present(&got[3]),
+        MARKERS,
+        "the face comes back with the markers"
+    );
+}
