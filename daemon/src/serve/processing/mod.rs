@@ -108,6 +108,8 @@ pub(crate) struct Processing {
     last_merge: Instant,
     /// When quiet sources were last swept ([`Pipeline::forget_quiet_sources`]).
     last_sweep: Instant,
+    /// Ids of the streams the log has announced (the streams now, at most 64).
+    announced: Vec<i32>,
     processed_us: hdrhistogram::Histogram<u64>,
     /// Per stream id, capture → processed (see [`super::latency`]).
     latency: super::latency::StreamLatency,
@@ -145,6 +147,7 @@ impl Processing {
             closing: Vec::new(),
             last_merge: Instant::now(),
             last_sweep: Instant::now(),
+            announced: Vec::new(),
             processed_us: Stats::histogram(),
             latency: super::latency::StreamLatency::default(),
             monitor: shared.monitor,
@@ -376,6 +379,7 @@ impl Processing {
             .collect();
         s.streams = self.pipeline.stream_count() as u64;
         s.per_stream = self.pipeline.stream_status();
+        announce_streams(&mut self.announced, &s.per_stream);
         s.send = self.fanout.counters.clone();
         (s.poll_hits, s.poll_misses) = (self.poll_hits, self.poll_misses);
         s.clients = self.fanout.len() as u64;
@@ -390,5 +394,68 @@ impl Processing {
         let _ = s.sent_us.add(&self.fanout.sent_us);
         self.fanout.sent_us.reset();
         self.latency.merge_into(&mut s.stream_latency_us);
+    }
+}
+
+/// Logs each stream once as it appears, with how many of its model's markers its source names:
+/// the others are filled from the model, which only `/status` said.
+fn announce_streams(announced: &mut Vec<i32>, streams: &[crate::engine::StreamStatus]) {
+    for st in streams {
+        if announced.contains(&st.id) {
+            continue;
+        }
+        announced.push(st.id);
+        let named = st.model_markers.saturating_sub(st.unmatched_markers);
+        if st.unmatched_markers == 0 {
+            tracing::info!(target: "emoshift", stream = %st.name, markers = st.model_markers, "stream started");
+        } else {
+            tracing::warn!(
+                target: "emoshift",
+                stream = %st.name,
+                "stream started: its source names {named} of the model's {} markers; the other {} are filled from the model",
+                st.model_markers,
+                st.unmatched_markers
+            );
+        }
+    }
+    announced.retain(|id| streams.iter().any(|st| st.id == *id));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::{StreamKey, StreamStatus};
+
+    fn status(id: i32, unmatched: usize) -> StreamStatus {
+        StreamStatus {
+            key: StreamKey {
+                source: "127.0.0.1:9000".parse().expect("addr"),
+                layout_id: id,
+            },
+            id,
+            name: format!("s{id}"),
+            performer: None,
+            model_markers: 109,
+            unmatched_markers: unmatched,
+            target: String::new(),
+            amount: 0.0,
+            frames: 1,
+            duplicates: 0,
+            stale: 0,
+        }
+    }
+
+    /// Each stream is announced once while it lives, and again if it comes back after going.
+    #[test]
+    fn streams_are_announced_once_while_they_live() {
+        let mut announced = Vec::new();
+        announce_streams(&mut announced, &[status(0, 0), status(1, 69)]);
+        assert_eq!(announced, [0, 1]);
+        announce_streams(&mut announced, &[status(0, 0), status(1, 69)]);
+        assert_eq!(announced, [0, 1]);
+        announce_streams(&mut announced, &[status(1, 69)]);
+        assert_eq!(announced, [1], "a stream gone is forgotten");
+        announce_streams(&mut announced, &[status(1, 69), status(0, 0)]);
+        assert_eq!(announced, [1, 0]);
     }
 }
