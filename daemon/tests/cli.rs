@@ -243,32 +243,24 @@ fn train_project_edit_round_trip_on_synth_output() {
     };
     let other = dir.path().join("other.trc");
     let other = p(&other);
-    usage(
-        &[
-            "edit",
-            "--model",
-            p(&model),
-            take,
-            "--out",
-            other,
-            "--gain",
-            "1=11",
-        ],
-        "outside -10..10",
-    );
-    usage(
-        &[
-            "edit",
-            "--model",
-            p(&model),
-            take,
-            "--out",
-            other,
-            "--translate",
-            "1=1e6",
-        ],
-        "outside -100..100",
-    );
+    for (flag, value, needle) in [
+        ("--gain", "1=11", "outside -10..10"),
+        ("--translate", "1=1e6", "outside -100..100"),
+    ] {
+        usage(
+            &[
+                "edit",
+                "--model",
+                p(&model),
+                take,
+                "--out",
+                other,
+                flag,
+                value,
+            ],
+            needle,
+        );
+    }
     // An output named as a take format the command does not write.
     let wrong = dir.path().join("u.c3d");
     let wrong = p(&wrong);
