@@ -8,6 +8,7 @@ mod e2e {
     mod faults;
     mod monitor;
     mod natnet;
+    mod regression_30;
     mod shutdown;
     mod stage;
 }
