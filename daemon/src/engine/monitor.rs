@@ -9,7 +9,7 @@
 //! shell swaps it with the one it published last, so buffers are reused, not reallocated) and
 //! calls nothing else. Filling allocates only while a snapshot's buffers grow to the largest
 //! stream seen (a new stream, a bigger model); warm, the tap allocates nothing
-//! (daemon/tests/pipeline_alloc.rs counts it).
+//! (daemon/tests/it/pipeline_alloc.rs counts it).
 
 use std::sync::Arc;
 

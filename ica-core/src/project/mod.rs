@@ -2,7 +2,7 @@
 //!
 //! `u = W (x − mean)`, edit `u → u'`, `x' = mean + M u'` (paper section 5), in f32 with every
 //! buffer allocated by [`Projector::new`]; a frame call allocates nothing (held by
-//! `tests/alloc.rs`).
+//! `tests/it/alloc.rs`).
 //!
 //! **Precision.** `W`, `M` and the mean are f32 copies of the model's f64 matrices. A frame
 //! round trip (project, resynthesise) differs from the f64 computation by about

@@ -26,7 +26,7 @@ const PRECISION: usize = 4 + 4;
 /// Decodes a NAT_FRAMEOFDATA datagram (header included) of NatNet `version` into `frame`.
 ///
 /// `frame` is cleared first; on error it holds whatever was decoded before the error. Once
-/// its lists are large enough this allocates nothing (see `tests/natnet_alloc.rs`).
+/// its lists are large enough this allocates nothing (see `tests/it/natnet_alloc.rs`).
 ///
 /// # Errors
 ///

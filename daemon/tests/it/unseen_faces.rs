@@ -12,8 +12,7 @@ use ica_core::quality::WarningKind;
 use ica_core::stabilise::{to_world_into, Stabiliser};
 use replay::synth::{generate_session, Layout, MarkerSet, Naming, RigidMarkers, SynthParams};
 
-mod common;
-use common::{corr, ok as emoshift, p as s, project_series};
+use crate::common::{corr, ok as emoshift, p as s, project_series};
 
 fn fixture(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)

@@ -8,8 +8,7 @@ use daemon::offline::progress::Silent;
 use daemon::offline::training::{self, StreamOptions, TrainOptions, Trained};
 use daemon::offline::{self, LoadedTake};
 
-mod common;
-use common::p as s;
+use crate::common::p as s;
 
 fn fixture(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
@@ -125,7 +124,7 @@ fn issue_18_train_shows_progress_in_a_pipe() {
         s(&model),
         s(&take),
     ];
-    common::shows_progress(
+    crate::common::shows_progress(
         &args,
         &[
             "train: reading takes done: 1 takes in ",

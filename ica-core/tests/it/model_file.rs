@@ -4,7 +4,7 @@
 use ica_core::{IcaModel, ModelError, Role, FORMAT_VERSION};
 use serde_json::{json, Value};
 
-const GOLDEN: &str = include_str!("fixtures/golden-model-v1.json");
+const GOLDEN: &str = include_str!("../fixtures/golden-model-v1.json");
 
 fn golden_value() -> Value {
     serde_json::from_str(GOLDEN).expect("golden file is json")

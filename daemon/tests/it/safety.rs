@@ -1,12 +1,10 @@
 //! The command line on inputs a user did not mean: devices and huge files, outputs over
 //! inputs or over existing files, broken manifests and configs; and logs fit for a file.
 
-mod common;
-
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{ok, p, run};
+use crate::common::{ok, p, run};
 
 fn stderr_of(args: &[&str]) -> (Option<i32>, String) {
     let out = run(args);

@@ -11,8 +11,7 @@ use std::path::Path;
 use replay::synth::{generate_session, Synth, SynthParams};
 use replay::Take;
 
-mod common;
-use common::{ok as emoshift, p as s};
+use crate::common::{ok as emoshift, p as s};
 
 fn params(seed: u64, emotions: &[&str], dims: usize, sentences: usize) -> SynthParams {
     SynthParams {

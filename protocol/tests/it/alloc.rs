@@ -1,5 +1,5 @@
 //! The frame path allocates nothing once buffers exist: allocation-counter's counting global
-//! allocator (linked only into this test binary) decides.
+//! allocator (it counts per thread) decides.
 
 use protocol::*;
 

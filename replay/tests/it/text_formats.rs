@@ -8,7 +8,6 @@ use rand_chacha::ChaCha8Rng;
 use replay::{csv, trc, Format, ReadError, Take, Units};
 
 /// Damaged input: one typed error per kind of damage, and no panics.
-#[path = "text_formats/errors.rs"]
 mod errors;
 
 pub(crate) fn fixture(name: &str) -> PathBuf {

@@ -7,11 +7,9 @@
 //! a share of the session's longest take, binds on the warped take's pairs only if a
 //! sentence's band came from that sentence alone.
 
-mod common;
-
 use std::path::Path;
 
-use common::{ok, p};
+use crate::common::{ok, p};
 use daemon::offline::analysis::{self, Inputs};
 use daemon::offline::progress::Silent;
 use daemon::offline::{self};
@@ -180,7 +178,7 @@ fn issue_18_analyze_shows_progress_in_a_pipe() {
     let (manifest, model) = session(dir.path(), 2);
     let report = dir.path().join("report");
     let args = ["analyze", "--model", p(&model), "--manifest", p(&manifest)];
-    common::shows_progress(
+    crate::common::shows_progress(
         &[&args[..], &["--out", p(&report)]].concat(),
         &[
             "analyze: reading headers done: 8 takes in ",
@@ -202,7 +200,7 @@ fn a_take_whose_header_lies_about_its_length_is_an_error_not_an_abort() {
     lines[2] = values.join("\t");
     std::fs::write(&trc, lines.join("\n")).expect("write trc");
     let report = dir.path().join("report");
-    let out = common::run(&[
+    let out = crate::common::run(&[
         "analyze",
         "--model",
         p(&model),

@@ -1,11 +1,9 @@
 //! The command line as a user runs it: formats, errors, the offline round trip, and analysis
 //! without emotion pairs.
 
-mod common;
-
 use std::path::Path;
 
-use common::{ok, p, run};
+use crate::common::{ok, p, run};
 
 /// Runs a command that must fail: exit code 1, one line on stderr naming `needle`, no panic.
 fn fails(args: &[&str], needle: &str) {

@@ -1,11 +1,9 @@
 //! The real Motive 2.1 capture against what NaturalPoint's SampleClient printed for it, and
 //! the single command packets against their known contents.
 
-mod natnet_fixtures;
-
 use std::collections::HashMap;
 
-use natnet_fixtures::*;
+use crate::natnet_fixtures::*;
 use protocol::natnet::*;
 
 /// `%.2f` as SampleClient (built with MSVC) prints it. That CRT first converts to 17

@@ -2,11 +2,9 @@
 //! whole-take path writes, whatever the block size, input and output format, across gaps,
 //! glitches and held head poses that carry state from one block into the next.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{ok, p};
+use crate::common::{ok, p};
 use daemon::offline::edit::{edit_take, EditRequest};
 use daemon::offline::progress::Silent;
 use daemon::offline::{self, streamed};

@@ -1,7 +1,5 @@
 //! Helpers shared by the CLI-level test files: run the `emoshift` binary as a user would.
 
-#![allow(dead_code)] // each test file uses a different subset
-
 use std::path::Path;
 use std::process::{Command, Output};
 

@@ -17,7 +17,6 @@
 //! `EMOSHIFT_BLESS=1`. Bless again only for a change that is meant to alter the bytes
 //! (the numerics of projection or edit, the wire format), and say so in the commit.
 
-use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 

@@ -6,8 +6,7 @@ use std::path::Path;
 
 use replay::synth::{load_truth, Synth, SynthParams};
 
-mod common;
-use common::{corr, ok as emoshift, project_series};
+use crate::common::{corr, ok as emoshift, project_series};
 
 fn params(seed: u64, sentences: usize) -> SynthParams {
     SynthParams {

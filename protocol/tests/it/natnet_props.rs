@@ -1,9 +1,7 @@
 //! NatNet property tests: encode → decode round trips for every message emoshift encodes,
 //! and no panic on arbitrary bytes, truncations and bit flips of real packets.
 
-mod natnet_fixtures;
-
-use natnet_fixtures::*;
+use crate::natnet_fixtures::*;
 use proptest::prelude::*;
 use protocol::natnet::*;
 

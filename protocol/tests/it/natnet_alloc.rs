@@ -1,11 +1,9 @@
 //! The NatNet frame path allocates nothing once the reused `FrameOfData` has grown:
-//! allocation-counter's counting global allocator (linked only into this test binary) decides.
-
-mod natnet_fixtures;
+//! allocation-counter's counting global allocator (it counts per thread) decides.
 
 use std::time::{Duration, Instant};
 
-use natnet_fixtures::capture_frames;
+use crate::natnet_fixtures::capture_frames;
 use protocol::natnet::*;
 
 /// A 109-marker face in a NatNet 4.1 frame, as a Motive markerset would stream it.

@@ -8,8 +8,7 @@ use daemon::offline::training::{self, HeadChoice, PrepOptions, SpeedLimit};
 use daemon::offline::{self, LoadedTake};
 use ica_core::model::IcaModel;
 
-mod common;
-use common::{ok as emoshift, p as s};
+use crate::common::{ok as emoshift, p as s};
 
 fn fixture(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)

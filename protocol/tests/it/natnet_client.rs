@@ -1,10 +1,8 @@
 //! The sans-IO client session against a scripted Motive stand-in: fake clock, bytes in memory.
 
-mod natnet_fixtures;
-
 use std::time::{Duration, Instant};
 
-use natnet_fixtures::fixture;
+use crate::natnet_fixtures::fixture;
 use protocol::natnet::*;
 
 const HZ: u64 = 3_312_787;
@@ -231,7 +229,7 @@ fn a_bitstream_reply_switches_the_frame_version() {
     assert_eq!(events(&mut c), [Event::VersionChanged(NatNetVersion::V3_1)]);
     assert_eq!(c.frame_version(), Some(NatNetVersion::V3_1));
     // the real capture's command exchange leaves a connected client connected
-    for d in natnet_fixtures::traffic()
+    for d in crate::natnet_fixtures::traffic()
         .iter()
         .filter(|d| d.src_port == 1510)
     {

@@ -1,0 +1,11 @@
+//! End-to-end tests of `emoshift serve` on loopback: one binary, one topic per module.
+
+mod control;
+mod edit;
+mod faults;
+mod monitor;
+mod natnet;
+mod regression_30;
+mod shutdown;
+mod stage;
+mod support;
