@@ -66,6 +66,30 @@ pub enum SynthError {
     /// Two explicit points for the same emotion.
     #[error("emotion {0:?} is given two points")]
     DuplicatePoint(String),
+    /// A `name=value` item of a variant knob does not parse.
+    #[error("{text:?} must be name=number, e.g. angry=3")]
+    NameValueSyntax {
+        /// The text given.
+        text: String,
+    },
+    /// A variant knob out of its range.
+    #[error("{knob} {value} is out of range: expected {expected}")]
+    BadVariation {
+        /// The knob.
+        knob: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it accepts.
+        expected: String,
+    },
+    /// A variant knob given twice for one emotion.
+    #[error("{knob} is given twice for emotion {emotion:?}")]
+    RepeatedVariation {
+        /// The knob.
+        knob: &'static str,
+        /// The emotion.
+        emotion: String,
+    },
     /// A take's level vector does not have one level per emotion direction.
     #[error("take levels have {got} coordinates, the emotion space has {expected}")]
     LevelDims {

@@ -53,6 +53,7 @@ pub mod sources;
 pub mod space;
 pub mod speech;
 pub mod truth;
+pub mod variation;
 pub mod warp;
 
 pub use columns::{SourceInfo, SourceLayout, MAX_EMOTION_DIMS};
@@ -64,6 +65,7 @@ pub use session_io::{generate_session, write_session, SessionSummary, SynthSessi
 pub use space::EmotionPoint;
 pub use speech::Sentence;
 pub use truth::{load_truth, MixingTruth, SessionTruth, TakeTruth};
+pub use variation::{NameValue, Variation};
 pub use warp::Warp;
 
 use seeds::{name_key, sub_rng, sub_seed, Stream};
@@ -105,6 +107,8 @@ pub struct SynthParams {
     pub head_motion: bool,
     /// The face layout: markers, names, rigid markers, placement.
     pub layout: Layout,
+    /// Session variants the method was not built around ([`variation`]); the default is none.
+    pub variation: Variation,
 }
 
 impl Default for SynthParams {
@@ -118,6 +122,7 @@ impl Default for SynthParams {
             rate_hz: DEFAULT_RATE_HZ,
             head_motion: false,
             layout: Layout::default(),
+            variation: Variation::default(),
         }
     }
 }
@@ -140,7 +145,8 @@ impl SynthParams {
         }
         self.validate_emotions()?;
         SourceLayout::new(self.emotion_dims)?;
-        self.validate_points()
+        self.validate_points()?;
+        self.variation.validate(&self.emotions, self.sentences)
     }
 
     fn validate_emotions(&self) -> Result<(), SynthError> {
@@ -197,6 +203,8 @@ pub struct Synth {
     mixing: Vec<f64>,
     sentences: Vec<Sentence>,
     points: Vec<Vec<f64>>,
+    /// Per emotion (list order), whether it is spoken in each sentence.
+    spoken: Vec<Vec<bool>>,
 }
 
 impl Synth {
@@ -211,9 +219,26 @@ impl Synth {
         let sentences = (0..params.sentences)
             .map(|i| Sentence::generate(params.seed, i, params.sentences))
             .collect();
+        let mut mixing = mixing::mixing_matrix(&face, params.layout.soft_nose(), columns);
+        let v = &params.variation;
+        if v.spread_effects > 0.0 {
+            variation::add_spread_effects(
+                &mut mixing,
+                &face,
+                columns,
+                params.seed,
+                v.spread_effects,
+            );
+        }
+        let spoken = params
+            .emotions
+            .iter()
+            .map(|e| variation::spoken_in(params.seed, e, v.takes_of(e), params.sentences))
+            .collect();
         Ok(Synth {
             rest: face.rest_flat(),
-            mixing: mixing::mixing_matrix(&face, params.layout.soft_nose(), columns),
+            mixing,
+            spoken,
             points: space::emotion_points(
                 &params.emotions,
                 params.emotion_dims,
@@ -303,8 +328,33 @@ impl Synth {
         format!("{id}_{emotion}")
     }
 
-    /// The session's take of `sentence` in `emotion`: its levels (base point x per-sentence
-    /// intensity), its own random warp and its own seed.
+    /// Whether the session has a take of `sentence` in `emotion` (every sentence is spoken in
+    /// every emotion unless [`Variation::takes`] says otherwise).
+    pub fn spoken(&self, sentence: usize, emotion: &str) -> bool {
+        self.emotion_index(emotion)
+            .ok()
+            .and_then(|e| self.spoken[e].get(sentence).copied())
+            .unwrap_or(false)
+    }
+
+    /// The session's takes, sentence-major: (sentence, emotion).
+    pub fn takes(&self) -> Vec<(usize, &str)> {
+        (0..self.sentences.len())
+            .flat_map(|s| {
+                self.params
+                    .emotions
+                    .iter()
+                    .enumerate()
+                    .filter(move |(e, _)| self.spoken[*e][s])
+                    .map(move |(_, e)| (s, e.as_str()))
+            })
+            .collect()
+    }
+
+    /// The take of `sentence` in `emotion`: its levels (base point x per-take intensity, plus
+    /// the emotion x sentence offset of a [`Variation`]), its own random warp (at the emotion's
+    /// speech rate) and its own seed. Defined for every sentence and emotion, spoken in the
+    /// session or not.
     ///
     /// # Errors
     /// [`SynthError::SentenceOutOfRange`] or [`SynthError::UnknownEmotion`].
@@ -317,8 +367,21 @@ impl Synth {
                 count: self.sentences.len(),
             })?;
         let point = self.point_of(emotion)?;
-        let intensity = sources::sentence_intensity(self.params.seed, sentence, emotion);
-        let emotion_levels = point.iter().map(|p| p * intensity).collect();
+        let v = &self.params.variation;
+        let seed = self.params.seed;
+        let intensity = if v.take_intensity > 0.0 {
+            variation::take_intensity(seed, sentence, emotion, v.take_intensity)
+        } else {
+            sources::sentence_intensity(seed, sentence, emotion)
+        };
+        let mut emotion_levels: Vec<f64> = point.iter().map(|p| p * intensity).collect();
+        if v.interaction > 0.0 {
+            let offset =
+                variation::interaction(seed, sentence, emotion, point.len(), v.interaction);
+            for (l, o) in emotion_levels.iter_mut().zip(offset) {
+                *l += o;
+            }
+        }
         let seed = sub_seed(
             self.params.seed,
             Stream::Take,
@@ -330,10 +393,55 @@ impl Synth {
             sentence,
             emotion: emotion.to_string(),
             emotion_levels,
-            warp: Warp::random(&mut rng, s.duration_s, self.params.rate_hz),
+            warp: Warp::random_paced(
+                &mut rng,
+                s.duration_s,
+                self.params.rate_hz,
+                v.rate_of(emotion),
+            ),
             seed,
             noise: true,
         })
+    }
+
+    /// The truth of editing the take `spec` to emotion `target`: the same performance (timing,
+    /// drift, blinks, head motion, noise) at the levels `target` would have. With a per-take
+    /// intensity ([`Variation::take_intensity`]) those are the levels of `target`'s average
+    /// take in the session ([`Synth::mean_levels`]): the edit must remove the take's own
+    /// intensity and cannot know a target take's. Otherwise they are `target`'s own take of
+    /// the sentence, as [`TakeSpec::with_timing_of`] renders it.
+    ///
+    /// # Errors
+    /// As [`Synth::take_spec`].
+    pub fn counterfactual(&self, spec: &TakeSpec, target: &str) -> Result<TakeSpec, SynthError> {
+        let mut truth = self.take_spec(spec.sentence, target)?.with_timing_of(spec);
+        if self.params.variation.take_intensity > 0.0 {
+            truth.emotion_levels = self.mean_levels(target)?;
+        }
+        Ok(truth)
+    }
+
+    /// The mean levels of the session's takes in `emotion`: where its average take sits.
+    ///
+    /// # Errors
+    /// [`SynthError::UnknownEmotion`].
+    pub fn mean_levels(&self, emotion: &str) -> Result<Vec<f64>, SynthError> {
+        let dims = self.columns.emotion_dims();
+        let mut sum = vec![0.0; dims];
+        let mut count = 0usize;
+        for s in (0..self.sentences.len()).filter(|&s| self.spoken(s, emotion)) {
+            for (acc, l) in sum
+                .iter_mut()
+                .zip(self.take_spec(s, emotion)?.emotion_levels)
+            {
+                *acc += l;
+            }
+            count += 1;
+        }
+        if count == 0 {
+            return Ok(self.point_of(emotion)?.to_vec());
+        }
+        Ok(sum.into_iter().map(|v| v / count as f64).collect())
     }
 
     /// Renders a take.
@@ -346,17 +454,15 @@ impl Synth {
         render::render(self, spec)
     }
 
-    /// Every take of the session, sentence-major (s01 in each emotion, then s02, ...).
+    /// Every take of the session ([`Synth::takes`]), sentence-major (s01 in each emotion, then
+    /// s02, ...).
     ///
     /// # Errors
     /// As [`Synth::render_take`] (not expected for specs from [`Synth::take_spec`]).
     pub fn render_all(&self) -> Result<Vec<RenderedTake>, SynthError> {
-        let mut out = Vec::new();
-        for s in 0..self.sentences.len() {
-            for e in &self.params.emotions {
-                out.push(self.render_take(&self.take_spec(s, e)?)?);
-            }
-        }
-        Ok(out)
+        self.takes()
+            .into_iter()
+            .map(|(s, e)| self.render_take(&self.take_spec(s, e)?))
+            .collect()
     }
 }

@@ -30,6 +30,12 @@ pub(crate) enum Stream {
     /// Emotion drift of a take on emotion directions after the first; keyed by take seed and
     /// direction (the first keeps [`Stream::Drift`]).
     DirectionDrift = 10,
+    /// Which sentences an emotion with fewer takes is spoken in; keyed by emotion name.
+    Subset = 11,
+    /// Emotion x sentence offset of a point; keyed by sentence and emotion name.
+    Interaction = 12,
+    /// Spread effects of an emotion direction; keyed by direction.
+    Spread = 13,
 }
 
 /// SplitMix64 finaliser: a cheap, well-mixed bijection on u64.

@@ -76,6 +76,7 @@ impl Synth {
             noise_std_mm: NOISE_STD_MM,
             head_motion: self.params().head_motion,
             layout: self.params().layout.describe(),
+            variation: self.params().variation.describe(),
             head_pivot: HEAD_PIVOT,
         }
     }

@@ -79,6 +79,10 @@ pub struct MixingTruth {
     /// The face layout, described (empty in truth written before layouts existed).
     #[serde(default)]
     pub layout: String,
+    /// The session's variants, described (`none`; empty in truth written before variants
+    /// existed).
+    #[serde(default)]
+    pub variation: String,
     /// Pivot of the head rotations, mm.
     pub head_pivot: [f64; 3],
 }
