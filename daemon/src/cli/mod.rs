@@ -8,8 +8,8 @@ mod values;
 
 pub use live::{BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, WireFormat};
 pub use offline::{
-    AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InspectArgs, KeyValue, ProjectArgs, SynthArgs,
-    TrainArgs,
+    AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InjectArgs, InspectArgs, KeyValue, ProjectArgs,
+    SynthArgs, TrainArgs,
 };
 
 /// A command-line error on one line, as every other failure is: clap's message with its
@@ -61,6 +61,16 @@ pub enum Command {
         spare points at least 0.5 from every other point. The truth (truth/mixing.json) records \
         every point.")]
     Synth(SynthArgs),
+    /// Cut real captures into a paired session with a known signal: each level of a smooth
+    /// field, added in head coordinates, is an "emotion" (truth in truth/inject.json).
+    #[command(
+        after_help = "Examples:\n  emoshift inject Facial-Sing.c3d --out sing --seed 3\n  \
+        emoshift inject JawMoCap.c3d EyebrowsMoCap.c3d --out anim --head-reference ForeHead_M,ForeHead_L,ForeHead_R,NoseTop\n\n\
+        Then: emoshift train --manifest sing/session.toml --out sing/model.json; emoshift analyze \
+        --model sing/model.json --manifest sing/session.toml --regions REGIONS --out sing/report \
+        --write-model; emoshift edit ... --to-emotion level3."
+    )]
+    Inject(InjectArgs),
     /// Show a take's labels, rate, frame range, units and missing samples per marker.
     #[command(after_help = "Examples:\n  emoshift info take.c3d\n  emoshift info take.trc --json")]
     Info(InfoArgs),

@@ -50,6 +50,68 @@ pub struct SynthArgs {
     /// by up to 8 %), so the face is not the default one.
     #[arg(long, default_value_t = 0.0, value_parser = super::values::non_negative)]
     pub placement_jitter: f64,
+    /// Each take its own emotion intensity, 1 ± this (0 to 0.9; default: ±0.15 by sentence);
+    /// the truth of an edit is then the target emotion's average take.
+    #[arg(long, default_value_t = 0.0, value_name = "SPREAD")]
+    pub take_intensity: f64,
+    /// Spread each emotion direction over the speech, brow and lid fields and a smooth field
+    /// over the whole face, at this strength (0 to 3; 1 is about as strong as the emotion).
+    #[arg(long, default_value_t = 0.0, value_name = "STRENGTH")]
+    pub spread_effects: f64,
+    /// Speak an emotion in only N of the sentences (drawn by the seed), e.g. angry=3.
+    #[arg(long, value_name = "NAME=N", value_delimiter = ',')]
+    pub takes: Vec<replay::synth::NameValue>,
+    /// Each emotion shows a little differently per sentence: every take's point moves by a
+    /// random offset with this standard deviation per direction (0 to 1).
+    #[arg(long, default_value_t = 0.0, value_name = "STD")]
+    pub interaction: f64,
+    /// An emotion speaks faster or slower, e.g. angry=1.2,sad=0.85 (0.5 to 2).
+    #[arg(long, value_name = "NAME=FACTOR", value_delimiter = ',')]
+    pub speech_rate: Vec<replay::synth::NameValue>,
+    /// File format of the takes: c3d, trc or csv.
+    #[arg(long, default_value = "c3d")]
+    pub format: String,
+    /// Overwrite the output if it exists.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `emoshift inject`.
+#[derive(Debug, Args)]
+pub struct InjectArgs {
+    /// Real captures (.c3d, .trc or .csv) with the same markers and rate, cut in order.
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// Output folder (created if needed).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Seed of the field, the cuts and the paces.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Levels of the field, each an "emotion" (level1, level2, ...).
+    #[arg(long, default_value_t = crate::offline::inject::DEFAULT_LEVELS)]
+    pub levels: usize,
+    /// RMS of the field over the face markers at the top level, mm.
+    #[arg(long, default_value_t = crate::offline::inject::DEFAULT_FIELD_MM)]
+    pub field_mm: f64,
+    /// Length of a sentence (a window of the captures), seconds.
+    #[arg(long, default_value_t = crate::offline::inject::DEFAULT_SENTENCE_S)]
+    pub sentence_s: f64,
+    /// Largest move of each end of a take from its sentence's window, seconds.
+    #[arg(long, default_value_t = crate::offline::inject::DEFAULT_JITTER_S)]
+    pub jitter_s: f64,
+    /// Largest pace change of a take (0.08: up to 8 % faster or slower).
+    #[arg(long, default_value_t = crate::offline::inject::DEFAULT_PACE_SPREAD)]
+    pub pace_spread: f64,
+    /// Regions file of the captures' markers: copied into the session as regions.toml, where
+    /// train and analyze find it, and its head_reference is the default head reference.
+    #[arg(long)]
+    pub regions: Option<PathBuf>,
+    /// Rigid head markers whose frame the field is in: auto, none (world coordinates), or
+    /// comma-separated labels or globs (default: the regions file's head_reference, else
+    /// auto; chosen as train chooses it).
+    #[arg(long)]
+    pub head_reference: Option<String>,
     /// File format of the takes: c3d, trc or csv.
     #[arg(long, default_value = "c3d")]
     pub format: String,

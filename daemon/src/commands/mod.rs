@@ -6,6 +6,7 @@ mod convert;
 mod demo;
 mod edit;
 mod info;
+mod inject;
 mod inspect;
 pub mod progress;
 mod project;
@@ -56,6 +57,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Synth(args) => synth::run(&args),
         Command::Info(args) => info::run(&args),
+        Command::Inject(args) => inject::run(&args),
         Command::Convert(args) => convert::run(&args),
         Command::Train(args) => train::run(&args),
         Command::Project(args) => project::run(&args),

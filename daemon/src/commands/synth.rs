@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use replay::synth::space::emotion_points;
-use replay::synth::{write_session, Layout, SynthParams, DEFAULT_EMOTION_DIMS};
+use replay::synth::{write_session, Layout, SynthParams, Variation, DEFAULT_EMOTION_DIMS};
 
 use crate::cli::SynthArgs;
 use crate::exit::UsageError;
@@ -38,6 +38,13 @@ pub(crate) fn run(args: &SynthArgs) -> Result<()> {
             rigid: args.rigid,
             placement_jitter_mm: args.placement_jitter,
         },
+        variation: Variation {
+            take_intensity: args.take_intensity,
+            spread_effects: args.spread_effects,
+            takes: args.takes.clone(),
+            interaction: args.interaction,
+            speech_rate: args.speech_rate.clone(),
+        },
     };
     params.validate().map_err(|e| UsageError(e.to_string()))?;
     crate::offline::output::check_out_dir(&args.out, args.force)?;
@@ -53,6 +60,9 @@ pub(crate) fn run(args: &SynthArgs) -> Result<()> {
         summary.dir.display()
     );
     crate::out!("emotion points: {}", describe_points(&params));
+    if !params.variation.is_none() {
+        crate::out!("variants: {}", params.variation.describe());
+    }
     crate::out!("manifest: {}", summary.manifest.display());
     Ok(())
 }

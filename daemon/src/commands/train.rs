@@ -34,7 +34,7 @@ fn regions(args: &TrainArgs) -> Result<Option<Regions>> {
 
 /// The head reference: `--head-reference`, else the regions file's `head_reference`, else
 /// auto with `patterns`.
-fn head_choice(
+pub(crate) fn head_choice(
     head_reference: Option<&str>,
     patterns: &[String],
     regions: Option<&Regions>,

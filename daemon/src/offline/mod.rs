@@ -6,6 +6,7 @@
 
 pub mod analysis;
 pub mod edit;
+pub mod inject;
 pub mod output;
 pub mod progress;
 pub mod streamed;
