@@ -378,6 +378,11 @@ pub struct AnalyzeArgs {
     /// Store the roles and emotion levels in the model file.
     #[arg(long)]
     pub write_model: bool,
+    /// Axes of the emotion space the model gets: fitted (over every component, whatever way
+    /// ICA split the emotion) or components (the emotion components themselves, as before
+    /// issue 34; for comparison).
+    #[arg(long, default_value = "fitted")]
+    pub axes: crate::offline::analysis::Axes,
     /// Overwrite the output if it exists.
     #[arg(long)]
     pub force: bool,

@@ -15,8 +15,45 @@ pub(crate) fn run(args: &AnalyzeArgs) -> Result<()> {
     let to = Report {
         dir: &args.out,
         write_model: args.write_model,
+        axes: args.axes,
     };
     analyze_and_write(&args.model, &args.manifest, args.regions.as_deref(), &to).map(drop)
+}
+
+/// The fitted space's axes, tests, points and conditioning, when the session shows one.
+fn print_fitted(report: &analysis::Report, m: usize) -> Result<()> {
+    let Some(space) = &report.space else {
+        return Ok(());
+    };
+    let Some(basis) = &space.basis else {
+        return Ok(());
+    };
+    let tests: Vec<String> = basis
+        .tests
+        .iter()
+        .map(|t| format!("F {:.1}{}", t.f, if t.kept { "" } else { " (not kept)" }))
+        .collect();
+    crate::out!(
+        "space: {} axes fitted over all {m} components ({}; offsets from {})",
+        basis.axes.len(),
+        tests.join(", "),
+        if basis.aligned {
+            "aligned pairs"
+        } else {
+            "take means"
+        }
+    );
+    let names: Vec<String> = (1..=basis.axes.len()).map(|j| format!("e{j}")).collect();
+    for (name, point) in &basis.points {
+        crate::out!(
+            "  point {name}: {}",
+            super::inspect::point_text(&names, &point.level)
+        );
+    }
+    if let Some(c) = &space.conditioning {
+        crate::out!("conditioning: {}", c.note);
+    }
+    Ok(())
 }
 
 /// Where [`analyze_and_write`] puts its results.
@@ -25,6 +62,8 @@ pub(crate) struct Report<'a> {
     pub dir: &'a Path,
     /// Roles and emotion levels go into the model file too.
     pub write_model: bool,
+    /// The axes of the emotion space the model gets.
+    pub axes: analysis::Axes,
 }
 
 /// Analyses the model at `model_path` on the session at `manifest`, writes the report and
@@ -71,7 +110,8 @@ pub(crate) fn analyze_and_write(
     match &report.space {
         Some(space) if space.components.len() > 1 => {
             for (name, point) in &space.points {
-                let text = super::inspect::point_text(&space.components, &point.level);
+                let names: Vec<String> = space.components.iter().map(|k| format!("c{k}")).collect();
+                let text = super::inspect::point_text(&names, &point.level);
                 crate::out!("level {name}: {text}");
             }
         }
@@ -81,8 +121,9 @@ pub(crate) fn analyze_and_write(
             }
         }
     }
+    print_fitted(&report, model.components())?;
     if to.write_model {
-        analysis::write_into_model(&mut model, &report)?;
+        analysis::write_into_model(&mut model, &report, to.axes)?;
         let file = std::fs::File::create(model_path)
             .with_context(|| format!("cannot write {}", model_path.display()))?;
         model.save(std::io::BufWriter::new(file))?;

@@ -35,18 +35,33 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     );
     let emotion = model.emotion();
     let space = emotion.space_components();
+    let list: Vec<String> = space.iter().map(|c| format!("c{c}")).collect();
     match emotion.component {
+        _ if !emotion.axes.is_empty() => crate::out!(
+            "emotion:    {} axes fitted over all {} components (emotion components {})",
+            emotion.dims(),
+            model.components(),
+            if list.is_empty() {
+                "none".to_string()
+            } else {
+                list.join(", ")
+            }
+        ),
         Some(k) if space.len() > 1 => {
-            let list: Vec<String> = space.iter().map(|c| format!("c{c}")).collect();
             crate::out!("emotion:    components {} (main c{k})", list.join(", "));
         }
         Some(k) => crate::out!("emotion:    component {k}"),
+        None if emotion.dims() > 0 => crate::out!("emotion:    components {}", list.join(", ")),
         None => crate::out!("emotion:    not analysed (run `emoshift analyze --write-model`)"),
     }
+    let names = emotion.axis_names();
     for name in emotion.names() {
         if let Some(point) = emotion.point(&name) {
-            crate::out!("  level {name}: {}", point_text(&space, &point));
+            crate::out!("  level {name}: {}", point_text(&names, &point));
         }
+    }
+    if let Some(c) = &emotion.conditioning {
+        crate::out!("  conditioning: {}", c.note);
     }
     crate::out!("roles:");
     for (k, role) in model.roles().iter().enumerate() {
@@ -60,15 +75,15 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     print_quality(model.quality())
 }
 
-/// An emotion's point: its level on the one emotion component, or `c0 0.1234, c2 -0.5678`
-/// over several.
-pub(crate) fn point_text(components: &[usize], point: &[f64]) -> String {
+/// An emotion's point: its level on the one axis, or `c0 0.1234, c2 -0.5678` over several
+/// (`axes` names them: `c0`, `e1`, ...).
+pub(crate) fn point_text(axes: &[String], point: &[f64]) -> String {
     match point {
         [level] => format!("{level:.4}"),
-        _ => components
+        _ => axes
             .iter()
             .zip(point)
-            .map(|(k, v)| format!("c{k} {v:.4}"))
+            .map(|(k, v)| format!("{k} {v:.4}"))
             .collect::<Vec<_>>()
             .join(", "),
     }

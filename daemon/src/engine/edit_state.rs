@@ -2,17 +2,18 @@
 //! from frame numbers and the model rate), never on the wall clock, so a test or an offline run
 //! sees exactly what the daemon does.
 //!
-//! The edit, for every emotion component `E` of the model's emotion space (one or more):
-//! `u_E' = u_E + amount · (target_E − lowpass(u_E))`, where `target` is the point of the target
-//! emotion (or of a blend) in that space, and the one-pole low-pass has the window as time
-//! constant (default 1 s): the slow emotion level is moved, the fast speech motion of the same
-//! components is kept. Raw alpha (`u_k + alpha_k`), gains (`g_k · u_k`) and bypass
+//! The edit, in the coordinates `y = A u` of the model's emotion space (its axes `A`, fitted
+//! over every component, or its emotion components themselves in older models):
+//! `u' = u + amount · M (target − lowpass(y))`, where `M` holds the components each axis moves,
+//! `target` is the point of the target emotion (or of a blend) in that space, and the one-pole
+//! low-pass has the window as time constant (default 1 s): the slow emotion level is moved, the
+//! fast speech motion of the same components is kept. Raw alpha (`u_k + alpha_k`), gains (`g_k · u_k`) and bypass
 //! complete it; with amount 0 and no bypass the result is bit-for-bit `FrameEdit::apply`
 //! (`u · g + alpha`), so the live and offline edits agree.
 //!
-//! `target` keeps the part of each component's level that belongs to what is said (see
-//! [`SpaceTarget`]): a component that carries emotion alone goes to the target's level, one
-//! whose level also follows the sentence keeps its own offset from the source emotion.
+//! `target` keeps the part of each axis's level that belongs to what is said (see
+//! [`SpaceTarget`]): an axis that carries emotion alone goes to the target's level, one whose
+//! level also follows the sentence keeps its own offset from the source emotion.
 //!
 //! Every setting glides from its current value to the new one over the ramp (default 0.25 s)
 //! on a smoothstep curve (`3t² − 2t³`): value and slope are continuous at both ends, so no
@@ -116,10 +117,10 @@ pub enum EditRefused {
 /// `dt_s`; settings (`set_*`) between frames.
 #[derive(Debug, Clone)]
 pub struct EditState {
-    /// The emotion components (the space's axes).
-    emotion: Vec<usize>,
+    /// Dimensions of the emotion space (0: the model has none).
+    dims: usize,
     target: String,
-    /// The target point, one glide per emotion component.
+    /// The target point, one glide per axis.
     level: Vec<Glide>,
     amount: Glide,
     alpha: Vec<Glide>,
@@ -127,21 +128,24 @@ pub struct EditState {
     wet: Glide,
     ramp_s: f32,
     lowpass_s: f32,
-    /// Low-pass of each emotion component; `None` before the first frame.
+    /// Low-pass of each coordinate in the emotion space; `None` before the first frame.
     lowpass: Option<Vec<f32>>,
     /// Preallocated storage for `lowpass` (moved in on the first frame, no allocation).
     lowpass_buf: Vec<f32>,
-    /// Where each emotion component goes to reach the target point (sentence share kept).
+    /// Where a take goes to reach the target point (sentence share kept), and the maps between
+    /// components and the space.
     space: SpaceTarget,
-    /// The target point now (glide values), and the levels to move to; per emotion component.
+    /// The target point now (glide values), and the coordinates to move to; per axis.
     goal: Vec<f32>,
     to: Vec<f32>,
+    /// This frame's coordinates, then the move along each axis.
+    coords: Vec<f32>,
     raw: Vec<f32>,
 }
 
 impl EditState {
-    /// An identity edit for `components` components; `emotion` are the emotion components
-    /// (empty: the model has none). Components out of range are ignored.
+    /// An identity edit for `components` components; `emotion` are the emotion components, each
+    /// an axis of the space (empty: the model has none). Components out of range are ignored.
     pub fn new(components: usize, emotion: &[usize], lowpass_s: f32) -> EditState {
         let emotion: Vec<usize> = emotion
             .iter()
@@ -149,26 +153,23 @@ impl EditState {
             .filter(|&k| k < components)
             .collect();
         let levels = ica_core::model::EmotionLevels {
-            components: emotion.clone(),
+            components: emotion,
             ..Default::default()
         };
-        EditState::with_space(components, emotion, SpaceTarget::new(&levels), lowpass_s)
+        EditState::with_space(components, SpaceTarget::new(&levels, components), lowpass_s)
     }
 
-    fn with_space(
-        components: usize,
-        emotion: Vec<usize>,
-        space: SpaceTarget,
-        lowpass_s: f32,
-    ) -> EditState {
+    fn with_space(components: usize, space: SpaceTarget, lowpass_s: f32) -> EditState {
+        let dims = space.dims();
         EditState {
             space,
-            goal: vec![0.0; emotion.len()],
-            to: vec![0.0; emotion.len()],
+            goal: vec![0.0; dims],
+            to: vec![0.0; dims],
+            coords: vec![0.0; dims],
             target: String::with_capacity(64),
-            level: vec![Glide::settled(0.0); emotion.len()],
-            lowpass_buf: vec![0.0; emotion.len()],
-            emotion,
+            level: vec![Glide::settled(0.0); dims],
+            lowpass_buf: vec![0.0; dims],
+            dims,
             amount: Glide::settled(0.0),
             alpha: vec![Glide::settled(0.0); components],
             gains: vec![Glide::settled(1.0); components],
@@ -183,16 +184,8 @@ impl EditState {
     /// The edit for a model: its components and emotion space (points, spreads and
     /// persistence included).
     pub fn for_model(model: &ica_core::IcaModel, lowpass_s: f32) -> EditState {
-        let space = model.emotion().space_components();
-        if space.iter().any(|&k| k >= model.components()) {
-            return EditState::new(model.components(), &[], lowpass_s);
-        }
-        EditState::with_space(
-            model.components(),
-            space,
-            SpaceTarget::new(model.emotion()),
-            lowpass_s,
-        )
+        let m = model.components();
+        EditState::with_space(m, SpaceTarget::new(model.emotion(), m), lowpass_s)
     }
 
     /// The target emotion (empty before one is set).
@@ -232,7 +225,7 @@ impl EditState {
     /// [`EditRefused::NoEmotion`] when the model has no emotion component,
     /// [`EditRefused::Dims`] for a point of the wrong length.
     pub fn set_target(&mut self, name: &str, point: &[f32]) -> Result<(), EditRefused> {
-        if self.emotion.is_empty() {
+        if self.dims == 0 {
             return Err(EditRefused::NoEmotion);
         }
         if point.len() != self.level.len() {
@@ -254,7 +247,7 @@ impl EditState {
     /// # Errors
     /// [`EditRefused::NoEmotion`] when the model has no emotion component.
     pub fn set_amount(&mut self, amount: f32) -> Result<(), EditRefused> {
-        if self.emotion.is_empty() {
+        if self.dims == 0 {
             return Err(EditRefused::NoEmotion);
         }
         self.amount.set(amount, self.ramp_s);
@@ -312,7 +305,7 @@ impl EditState {
         for ((ui, g), a) in u.iter_mut().zip(&self.gains).zip(&self.alpha) {
             *ui = *ui * g.value() + a.value();
         }
-        if !self.emotion.is_empty() && self.emotion.iter().all(|&k| k < u.len()) {
+        if self.dims > 0 && u.len() == self.raw.len() {
             self.edit_emotion(dt_s, wet, u);
         }
         if wet < 1.0 {
@@ -323,8 +316,8 @@ impl EditState {
         self.advance(dt_s);
     }
 
-    /// Moves every emotion component towards the target from its low-pass (taken before the
-    /// edit: of the raw value when bypass is gliding).
+    /// Moves the take towards the target from the low-pass of its coordinates (taken before
+    /// the edit: of the raw values when bypass is gliding).
     fn edit_emotion(&mut self, dt_s: f32, wet: f32, u: &mut [f32]) {
         let first = self.lowpass.is_none();
         let mut lp = self
@@ -336,8 +329,9 @@ impl EditState {
         } else {
             dt_s / (self.lowpass_s + dt_s)
         };
-        for (&k, y) in self.emotion.iter().zip(lp.iter_mut()) {
-            let x = if wet < 1.0 { self.raw[k] } else { u[k] };
+        let source: &[f32] = if wet < 1.0 { &self.raw } else { u };
+        self.space.coordinates_into(source, &mut self.coords);
+        for (&x, y) in self.coords.iter().zip(lp.iter_mut()) {
             // One-pole low-pass, started at the first value.
             *y = if first { x } else { *y + (x - *y) * gain };
         }
@@ -347,9 +341,10 @@ impl EditState {
                 *g = level.value();
             }
             self.space.target_into(&lp, &self.goal, &mut self.to);
-            for ((&k, y), to) in self.emotion.iter().zip(&lp).zip(&self.to) {
-                u[k] += amount * (to - y);
+            for ((delta, y), to) in self.coords.iter_mut().zip(&lp).zip(&self.to) {
+                *delta = to - y;
             }
+            self.space.move_into(&self.coords, amount, u);
         }
         self.lowpass = Some(lp);
     }
@@ -380,7 +375,7 @@ impl EditState {
         self.target.push_str(&other.target);
         // The target point carries over to a space of the same shape; the amount to any
         // space (a new model's points differ, so the target is re-resolved by the caller).
-        if !self.emotion.is_empty() && !other.emotion.is_empty() {
+        if self.dims > 0 && other.dims > 0 {
             self.amount = Glide::settled(other.amount.goal());
             if self.level.len() == other.level.len() {
                 for (a, b) in self.level.iter_mut().zip(&other.level) {

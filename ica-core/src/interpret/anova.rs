@@ -64,6 +64,31 @@ impl Blocks {
         }
     }
 
+    /// The additive fit's effects of levels `y`: one per emotion (the first emotion's is 0)
+    /// and one per sentence, so that take `r` is fitted by
+    /// `sentence[sentence(r)] + emotion[emotion(r)]`; `None` when it is singular.
+    pub(super) fn effects(&self, y: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+        let within = self.within.as_ref()?;
+        let s_mean = group_means(y, &self.sentence, &self.per_sentence);
+        let mut b = DVector::<f64>::zeros(self.per_emotion.len() - 1);
+        for (r, &v) in y.iter().enumerate() {
+            if self.emotion[r] > 0 {
+                b[self.emotion[r] - 1] += v - s_mean[self.sentence[r]];
+            }
+        }
+        let beta = within.solve(&b);
+        let emotion: Vec<f64> = std::iter::once(0.0).chain(beta.iter().copied()).collect();
+        let shifted: Vec<f64> = y
+            .iter()
+            .enumerate()
+            .map(|(r, v)| v - emotion[self.emotion[r]])
+            .collect();
+        Some((
+            emotion,
+            group_means(&shifted, &self.sentence, &self.per_sentence),
+        ))
+    }
+
     /// The three fits of levels `y` (one per take); `None` when the additive fit is singular.
     pub(super) fn fit(&self, y: &[f64]) -> Option<Fits> {
         let within = self.within.as_ref()?;

@@ -56,24 +56,25 @@ impl EmotionDistanceAcc {
         }
     }
 
-    /// Aligns one pair and adds its squared differences; returns its aligned samples.
+    /// Aligns one pair and adds its squared differences; returns its aligned samples and the
+    /// median of `b − a` over the aligned frames ([`aligned_offset`]).
     ///
     /// # Errors
     /// A series of the wrong shape, or an alignment failure (empty or non-finite series).
-    pub fn add_pair(&mut self, a: &[f64], b: &[f64]) -> Result<usize, InterpretError> {
+    pub fn add_pair(&mut self, a: &[f64], b: &[f64]) -> Result<AlignedPair, InterpretError> {
         let m = self.m;
-        // Shapes checked first, for a typed error naming the series.
-        frames_of(a, m)?;
-        frames_of(b, m)?;
-        let alignment = dtw::align(&dtw::demeaned(a, m), &dtw::demeaned(b, m), m, self.band)?;
-        for &(i, j) in &alignment.path {
+        let path = align_path(a, b, m, self.band)?;
+        for &(i, j) in &path {
             for (k, acc) in self.sum.iter_mut().enumerate() {
                 let d = a[i * m + k] - b[j * m + k];
                 *acc += d * d;
             }
         }
-        self.aligned_samples.push(alignment.path.len());
-        Ok(alignment.path.len())
+        self.aligned_samples.push(path.len());
+        Ok(AlignedPair {
+            samples: path.len(),
+            offset: path_offset(a, b, m, &path),
+        })
     }
 
     /// The metric over the pairs added (0 per component without pairs).
@@ -89,6 +90,75 @@ impl EmotionDistanceAcc {
             aligned_samples: self.aligned_samples,
         }
     }
+}
+
+/// One aligned pair: its aligned samples and the median of `b − a` over them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlignedPair {
+    /// Aligned samples (the DTW path's length).
+    pub samples: usize,
+    /// Median over the path of `b − a`, per component: where the second take sits relative
+    /// to the first with what both say matched frame by frame.
+    pub offset: Vec<f64>,
+}
+
+/// The DTW path of a pair (each series' own mean removed, so a level difference does not pull
+/// the alignment).
+fn align_path(
+    a: &[f64],
+    b: &[f64],
+    m: usize,
+    band: Option<usize>,
+) -> Result<Vec<(usize, usize)>, InterpretError> {
+    // Shapes checked first, for a typed error naming the series.
+    frames_of(a, m)?;
+    frames_of(b, m)?;
+    Ok(dtw::align(&dtw::demeaned(a, m), &dtw::demeaned(b, m), m, band)?.path)
+}
+
+/// The median over the path of `b − a`, per component: robust to the stretches where the
+/// two takes do not say the same thing (a take that starts earlier or ends later, a cough),
+/// which the forced ends of the path would otherwise average in.
+fn path_offset(a: &[f64], b: &[f64], m: usize, path: &[(usize, usize)]) -> Vec<f64> {
+    let mut d = vec![0.0; path.len()];
+    (0..m)
+        .map(|k| {
+            for (x, &(i, j)) in d.iter_mut().zip(path) {
+                *x = b[j * m + k] - a[i * m + k];
+            }
+            median(&mut d)
+        })
+        .collect()
+}
+
+/// The median of `values` (reordered), 0 when empty.
+fn median(values: &mut [f64]) -> f64 {
+    let n = values.len();
+    if n == 0 {
+        return 0.0;
+    }
+    values.sort_unstable_by(f64::total_cmp);
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+/// The median of `b − a` over the DTW-aligned frames of two takes of one sentence
+/// (Sakoe-Chiba radius `band`): the difference of their levels with the sentence's content
+/// matched frame by frame rather than averaged per take.
+///
+/// # Errors
+/// A series of the wrong shape, or an alignment failure (empty or non-finite series).
+pub fn aligned_offset(
+    a: &[f64],
+    b: &[f64],
+    m: usize,
+    band: Option<usize>,
+) -> Result<Vec<f64>, InterpretError> {
+    let path = align_path(a, b, m, band)?;
+    Ok(path_offset(a, b, m, &path))
 }
 
 /// `d_emotion,j` over pairs of component series of the same sentence in two emotions.

@@ -18,12 +18,14 @@
 //! - [`label`]: roles from the metrics, with the thresholds in [`LabelRules`].
 
 mod anova;
+mod basis;
 mod distance;
 mod effect;
 
+pub use basis::{emotion_basis, AxisTest, BasisTake, EmotionBasis};
 pub use distance::{
-    emotion_distance, level_distance, region_distance, series_means, ComponentMoments,
-    EmotionDistanceAcc, LevelDistanceAcc,
+    aligned_offset, emotion_distance, level_distance, region_distance, series_means, AlignedPair,
+    ComponentMoments, EmotionDistanceAcc, LevelDistanceAcc,
 };
 pub use effect::{
     emotion_effects, emotion_subspace, f_upper_tail, EmotionEffect, TakeMeans, EMOTION_ALPHA,

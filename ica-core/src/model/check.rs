@@ -5,7 +5,7 @@ use std::collections::{BTreeMap, HashMap};
 
 use nalgebra::DMatrix;
 
-use super::{CaptureSettings, EmotionPoint, ModelError, PINV_TOL, RANK_TOL};
+use super::{CaptureSettings, EmotionLevels, EmotionPoint, ModelError, PINV_TOL, RANK_TOL};
 use crate::report::TrainReport;
 
 /// Checks an emotion space against a model of `m` components: components in range, ascending
@@ -30,6 +30,56 @@ pub(crate) fn check_emotion_space(
         if p.level.len() != components.len() || !spread_ok || !finite {
             return Err(ModelError::NonFiniteLevel { name: name.clone() });
         }
+    }
+    Ok(())
+}
+
+/// Checks a whole emotion space against a model of `m` components: the components as
+/// [`check_emotion_space`] does when the space has no fitted axes; with axes, every axis and
+/// move a finite row of `m` values, as many moves as axes, and every point, spread and
+/// persistence one finite value per axis.
+pub(crate) fn check_emotion_levels(e: &EmotionLevels, m: usize) -> Result<(), ModelError> {
+    if e.axes.is_empty() && e.moves.is_empty() {
+        check_emotion_space(&e.components, &e.points, m)?;
+    } else {
+        check_emotion_space(&e.components, &BTreeMap::new(), m)?;
+        let bad = |name: &str| ModelError::NonFiniteLevel {
+            name: name.to_string(),
+        };
+        let rows_ok = |rows: &[Vec<f64>]| {
+            rows.len() == e.axes.len()
+                && rows
+                    .iter()
+                    .all(|r| r.len() == m && r.iter().all(|v| v.is_finite()))
+        };
+        if !rows_ok(&e.axes) {
+            return Err(bad("emotion axes"));
+        }
+        if !rows_ok(&e.moves) {
+            return Err(bad("emotion moves"));
+        }
+        let d = e.axes.len();
+        for (name, p) in &e.points {
+            let spread_ok = p.spread.is_empty() || p.spread.len() == d;
+            let finite = p.level.iter().chain(&p.spread).all(|v| v.is_finite());
+            if p.level.len() != d || !spread_ok || !finite {
+                return Err(bad(name));
+            }
+        }
+    }
+    let d = e.dims();
+    let persistence_ok = e.persistence.is_empty() || e.persistence.len() == d;
+    if !persistence_ok || e.persistence.iter().any(|v| !v.is_finite()) {
+        return Err(ModelError::NonFiniteLevel {
+            name: "persistence".into(),
+        });
+    }
+    if let Some(index) = e.component.filter(|&k| k >= m) {
+        return Err(ModelError::ComponentOutOfRange {
+            what: "emotion component",
+            index,
+            components: m,
+        });
     }
     Ok(())
 }

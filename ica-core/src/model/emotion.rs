@@ -3,10 +3,16 @@
 //!
 //! The paper's *Translate* moves one emotion component between two levels. Real emotions do not
 //! lie on one line (happy lifts the mouth corners, angry knits the brows, sad does some of
-//! both), so a model holds a subspace of `k` emotion components and every emotion is a point
-//! there: the mean over its takes, with the spread across takes kept. One emotion component is
-//! the special case `k = 1`, and models written before spaces existed (one `component` with
-//! scalar `levels`) read as exactly that.
+//! both), so a model holds an emotion space and every emotion is a point there: its level on
+//! each axis, with the spread across takes kept.
+//!
+//! The axes are weights on the components ([`EmotionLevels::axes`], with the components each
+//! one moves, [`EmotionLevels::moves`]), fitted over every component so that the space does not
+//! depend on how ICA split the emotion between components (issue 34,
+//! [`crate::interpret::emotion_basis`]). Models without axes use their emotion components
+//! themselves as axes (`k` components, `k` dimensions); one emotion component is the special
+//! case `k = 1`, and models written before spaces existed (one `component` with scalar
+//! `levels`) read as exactly that.
 
 use std::collections::BTreeMap;
 
@@ -41,10 +47,62 @@ pub struct EmotionLevels {
     /// Each emotion's point over `components`.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub points: BTreeMap<String, EmotionPoint>,
-    /// Per emotion component: the share of a take's deviation from its emotion's point that
-    /// belongs to its sentence and so persists in another emotion (0..1; empty: 0).
+    /// Per axis: the share of a take's deviation from its emotion's point that belongs to its
+    /// sentence and so persists in another emotion (0..1; empty: 0).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub persistence: Vec<f64>,
+    /// The axes of the space as weights on the components: a take's coordinate on axis `j` is
+    /// `axes[j] · u` (one row of one weight per component). Empty: the axes are `components`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub axes: Vec<Vec<f64>>,
+    /// The components a move of one unit along each axis changes (one row per axis, one value
+    /// per component), with `axes · movesᵀ = I`. Empty exactly when `axes` is.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub moves: Vec<Vec<f64>>,
+    /// How the space was found and whether its components alone would be a sound set of axes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub conditioning: Option<Conditioning>,
+}
+
+/// Whether the emotion components, one per axis, would make a sound space, and what was done
+/// (issue 34). ICA may split an emotion direction between components, or blend two directions
+/// into one: the components' levels then move together, or a restart finds other components.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Conditioning {
+    /// The emotion components that would be the axes: those whose take levels the emotions
+    /// explain (the per-component F test, most of their level variance).
+    pub components: Vec<usize>,
+    /// Dimensions the session shows (the test over all components).
+    pub dims: usize,
+    /// Condition number of the emotions' points on `components` (centred): large when two
+    /// components' levels move together.
+    pub condition: f64,
+    /// Emotion components the other training restarts did not find again, with their best
+    /// match (below 0.9).
+    #[serde(default)]
+    pub unstable: Vec<(usize, f64)>,
+    /// Pairs of emotion components whose take levels correlate by |r| ≥ 0.9, with r.
+    #[serde(default)]
+    pub collinear: Vec<(usize, usize, f64)>,
+    /// Whether the components alone would be an ill-conditioned space.
+    pub ill_conditioned: bool,
+    /// What the edits do, in words.
+    pub note: String,
+}
+
+/// A fitted emotion space for [`crate::IcaModel::set_fitted_space`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct FittedSpace {
+    /// Axes as weights on the components ([`EmotionLevels::axes`]).
+    pub axes: Vec<Vec<f64>>,
+    /// Moves along the axes ([`EmotionLevels::moves`]).
+    pub moves: Vec<Vec<f64>>,
+    /// Each emotion's point over the axes.
+    pub points: BTreeMap<String, EmotionPoint>,
+    /// Each axis's persistence.
+    pub persistence: Vec<f64>,
+    /// How it was found.
+    pub conditioning: Conditioning,
 }
 
 /// Why a blend or a point could not be formed.
@@ -85,7 +143,46 @@ impl EmotionLevels {
 
     /// Dimensions of the space (0 when not analysed).
     pub fn dims(&self) -> usize {
-        self.space_components().len()
+        if self.axes.is_empty() {
+            self.space_components().len()
+        } else {
+            self.axes.len()
+        }
+    }
+
+    /// Names of the axes, in order: `e1`, `e2`, ... for fitted axes, `c0`, `c3`, ... for
+    /// emotion components.
+    pub fn axis_names(&self) -> Vec<String> {
+        if self.axes.is_empty() {
+            self.space_components()
+                .iter()
+                .map(|k| format!("c{k}"))
+                .collect()
+        } else {
+            (1..=self.axes.len()).map(|j| format!("e{j}")).collect()
+        }
+    }
+
+    /// The axes as weights on `m` components and the moves along them, each `dims x m`
+    /// row-major: the fitted axes, or one emotion component per axis. Components outside the
+    /// model are left out (an invalid model is refused at load; this keeps callers safe).
+    pub fn axis_matrices(&self, m: usize) -> (Vec<f64>, Vec<f64>) {
+        if !self.axes.is_empty() {
+            let flat = |rows: &[Vec<f64>]| -> Vec<f64> {
+                rows.iter()
+                    .flat_map(|r| (0..m).map(|k| r.get(k).copied().unwrap_or(0.0)))
+                    .collect()
+            };
+            return (flat(&self.axes), flat(&self.moves));
+        }
+        let space = self.space_components();
+        let mut select = vec![0.0; space.len() * m];
+        for (j, &k) in space.iter().enumerate() {
+            if k < m {
+                select[j * m + k] = 1.0;
+            }
+        }
+        (select.clone(), select)
     }
 
     /// Emotion names with a point, in name order.
@@ -134,8 +231,9 @@ impl EmotionLevels {
     }
 }
 
-/// Where each emotion component should go to reach a goal point, frame by frame, allocation
-/// free (f32, buffers sized at construction).
+/// Where a take should go in the emotion space to reach a goal point, frame by frame,
+/// allocation free (f32, buffers sized at construction); with the maps between components and
+/// the space's coordinates ([`SpaceTarget::coordinates_into`], [`SpaceTarget::move_into`]).
 ///
 /// Moving a take to the goal's absolute levels is right for a component that carries emotion
 /// alone, but wipes out a component whose level also depends on what is said (its sentence):
@@ -146,6 +244,12 @@ impl EmotionLevels {
 #[derive(Debug, Clone)]
 pub struct SpaceTarget {
     dims: usize,
+    /// Components of the model.
+    components: usize,
+    /// Axes as weights on the components, dims x components.
+    axes: Vec<f32>,
+    /// Components moved per unit along each axis, dims x components.
+    moves: Vec<f32>,
     /// Emotion points, emotions x dims.
     points: Vec<f32>,
     /// 1 / pooled within-emotion variance, per dim.
@@ -155,9 +259,10 @@ pub struct SpaceTarget {
 }
 
 impl SpaceTarget {
-    /// The targeting of a model's emotion space.
-    pub fn new(levels: &EmotionLevels) -> SpaceTarget {
+    /// The targeting of a model's emotion space, for a model of `components` components.
+    pub fn new(levels: &EmotionLevels, components: usize) -> SpaceTarget {
         let dims = levels.dims();
+        let (axes, moves) = levels.axis_matrices(components);
         let names = levels.names();
         let points: Vec<f32> = names
             .iter()
@@ -187,6 +292,9 @@ impl SpaceTarget {
             .collect();
         SpaceTarget {
             dims,
+            components,
+            axes: axes.iter().map(|&v| v as f32).collect(),
+            moves: moves.iter().map(|&v| v as f32).collect(),
             weights: vec![0.0; names.len()],
             points,
             inv_var,
@@ -199,8 +307,31 @@ impl SpaceTarget {
         self.dims
     }
 
-    /// Writes into `out` the level each emotion component should take to reach `goal` from
-    /// the `current` levels. All three have [`SpaceTarget::dims`] values.
+    /// Writes the coordinates of components `u` in the space into `out` ([`SpaceTarget::dims`]
+    /// values); `u` has the model's components.
+    pub fn coordinates_into(&self, u: &[f32], out: &mut [f32]) {
+        let m = self.components;
+        for (o, axis) in out.iter_mut().zip(self.axes.chunks_exact(m)) {
+            *o = axis.iter().zip(u).map(|(a, x)| a * x).sum();
+        }
+    }
+
+    /// Adds to components `u` the move `scale · delta` in the space (`delta` has
+    /// [`SpaceTarget::dims`] values).
+    pub fn move_into(&self, delta: &[f32], scale: f32, u: &mut [f32]) {
+        let m = self.components;
+        for (&d, row) in delta.iter().zip(self.moves.chunks_exact(m)) {
+            let step = scale * d;
+            if step != 0.0 {
+                for (x, w) in u.iter_mut().zip(row) {
+                    *x += step * w;
+                }
+            }
+        }
+    }
+
+    /// Writes into `out` the coordinates a take should reach for `goal` from its `current`
+    /// coordinates. All three have [`SpaceTarget::dims`] values.
     pub fn target_into(&mut self, current: &[f32], goal: &[f32], out: &mut [f32]) {
         let d = self.dims;
         out[..d].copy_from_slice(&goal[..d]);
@@ -271,6 +402,9 @@ mod tests {
             levels: BTreeMap::new(),
             components: vec![0, 3],
             persistence: vec![],
+            axes: vec![],
+            moves: vec![],
+            conditioning: None,
             points: [
                 ("sad".to_string(), point(vec![-1.0, 2.0])),
                 ("angry".to_string(), point(vec![1.0, 0.0])),
@@ -296,17 +430,57 @@ mod tests {
             levels: BTreeMap::new(),
             components: vec![0, 1],
             persistence: vec![0.0, 1.0],
+            axes: vec![],
+            moves: vec![],
+            conditioning: None,
             points: [
                 ("happy".to_string(), point(vec![1.0, 0.0])),
                 ("sad".to_string(), point(vec![-1.0, 0.5])),
             ]
             .into(),
         };
-        let mut t = SpaceTarget::new(&space);
+        let mut t = SpaceTarget::new(&space, 2);
         let mut out = [0.0f32; 2];
         // A happy take whose second component sits 2.0 above happy's level (its sentence).
         t.target_into(&[1.05, 2.0], &[-1.0, 0.5], &mut out);
         assert!((out[0] + 1.0).abs() < 1e-6, "{out:?}");
         assert!((out[1] - 2.5).abs() < 1e-3, "{out:?}");
+    }
+
+    #[test]
+    fn fitted_axes_read_and_move_components() {
+        // One axis along c0 + c1 over three components; moving by 2 along it changes both.
+        let s = 0.5f64.sqrt();
+        let space = EmotionLevels {
+            axes: vec![vec![s, s, 0.0]],
+            moves: vec![vec![s, s, 0.0]],
+            points: [(
+                "happy".to_string(),
+                EmotionPoint {
+                    level: vec![1.0],
+                    spread: vec![0.1],
+                    takes: 3,
+                },
+            )]
+            .into(),
+            ..EmotionLevels::default()
+        };
+        assert_eq!(space.dims(), 1);
+        let t = SpaceTarget::new(&space, 3);
+        let mut at = [0.0f32];
+        t.coordinates_into(&[1.0, 1.0, 5.0], &mut at);
+        assert!((at[0] - 2.0 * s as f32).abs() < 1e-6);
+        let mut u = [0.0f32; 3];
+        t.move_into(&[2.0], 0.5, &mut u);
+        assert!((u[0] - s as f32).abs() < 1e-6 && (u[1] - s as f32).abs() < 1e-6 && u[2] == 0.0);
+        // Without axes, the components are the axes.
+        let plain = EmotionLevels {
+            components: vec![2],
+            ..EmotionLevels::default()
+        };
+        assert_eq!(
+            plain.axis_matrices(3),
+            (vec![0.0, 0.0, 1.0], vec![0.0, 0.0, 1.0])
+        );
     }
 }

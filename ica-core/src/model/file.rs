@@ -147,14 +147,7 @@ fn from_file(file: ModelFile) -> Result<IcaModel, ModelError> {
             got: (roles.len(), 1),
         });
     }
-    super::check_emotion_space(&file.emotion.components, &file.emotion.points, m)?;
-    if let Some(index) = file.emotion.component.filter(|&k| k >= m) {
-        return Err(ModelError::ComponentOutOfRange {
-            what: "emotion component",
-            index,
-            components: m,
-        });
-    }
+    super::check_emotion_levels(&file.emotion, m)?;
     if let Some(name) = file
         .emotion
         .levels

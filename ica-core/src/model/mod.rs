@@ -16,7 +16,9 @@ mod file;
 mod json_rows;
 mod take;
 
-pub use emotion::{BlendError, EmotionLevels, EmotionPoint, SpaceTarget};
+pub use emotion::{
+    BlendError, Conditioning, EmotionLevels, EmotionPoint, FittedSpace, SpaceTarget,
+};
 pub use error::ModelError;
 pub use file::FORMAT_VERSION;
 
@@ -26,7 +28,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-pub(crate) use check::{check_capture, check_emotion_space};
+pub(crate) use check::{check_capture, check_emotion_levels, check_emotion_space};
 use check::{check_finite, check_parts, check_pseudo_inverse, pseudo_inverse};
 
 /// A mixing matrix whose smallest singular value is at most `RANK_TOL` x its largest is
@@ -337,7 +339,48 @@ impl IcaModel {
             components,
             points,
             persistence,
+            ..EmotionLevels::default()
         };
+        Ok(())
+    }
+
+    /// Sets a fitted emotion space ([`crate::interpret::emotion_basis`]): its axes as weights
+    /// on the components, the moves along them, each emotion's point and spread over the
+    /// axes, their persistence, and how it was found. `components` are the components whose
+    /// levels differ between emotions (they get [`Role::Emotion`] as with
+    /// [`IcaModel::set_emotion_space`]); `levels` are the main component's level per emotion,
+    /// for tools that read one component.
+    ///
+    /// # Errors
+    /// [`ModelError::ComponentOutOfRange`] for a component outside the model,
+    /// [`ModelError::NonFiniteLevel`] for misshapen or non-finite axes, moves or points.
+    pub fn set_fitted_space(
+        &mut self,
+        components: Vec<usize>,
+        main: Option<usize>,
+        levels: BTreeMap<String, f64>,
+        space: FittedSpace,
+    ) -> Result<(), ModelError> {
+        let fitted = EmotionLevels {
+            component: main,
+            levels,
+            components,
+            points: space.points,
+            persistence: space.persistence,
+            axes: space.axes,
+            moves: space.moves,
+            conditioning: Some(space.conditioning),
+        };
+        check_emotion_levels(&fitted, self.components())?;
+        for (k, role) in self.roles.iter_mut().enumerate() {
+            if *role == Role::Emotion && !fitted.components.contains(&k) {
+                *role = Role::Unknown;
+            }
+        }
+        for &k in &fitted.components {
+            self.roles[k] = Role::Emotion;
+        }
+        self.emotion = fitted;
         Ok(())
     }
 

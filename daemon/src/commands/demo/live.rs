@@ -63,7 +63,7 @@ struct Moment {
     t: f64,
     target: String,
     amount: f32,
-    /// The emotion components of the received markers.
+    /// The received markers' coordinates on the emotion axes.
     emotion: Option<Vec<f32>>,
 }
 
@@ -179,23 +179,27 @@ fn send_take(take: &Take, to: SocketAddr, total: usize) -> Result<Sent> {
     })
 }
 
-/// Latencies, and the emotion components of what the client received (to show the sweep in
+/// Latencies, and the emotion coordinates of what the client received (to show the sweep in
 /// model units).
 fn measure(model: &IcaModel, seen: &[Seen], sent: &Sent, sweep: &[String], rate_hz: f64) -> Live {
     let mut latency_us = Stats::histogram();
     let mut processor = crate::engine::frame::FrameProcessor::new(model);
     let mut u = vec![0.0f32; model.components()];
-    let space = model.emotion().space_components();
+    let space = ica_core::model::SpaceTarget::new(model.emotion(), model.components());
     let mut moments = Vec::with_capacity(seen.len());
     for s in seen {
         if let Some(at) = sent.at.get(&i64::from(s.number)) {
             Stats::record(&mut latency_us, s.at.duration_since(*at).as_micros() as u64);
         }
-        let complete = !space.is_empty() && s.missing.len() == model.markers();
+        let complete = space.dims() > 0 && s.missing.len() == model.markers();
         let emotion = complete
             .then(|| processor.project(&s.positions, &s.missing, &mut u).ok())
             .flatten()
-            .map(|_| space.iter().map(|&k| u[k]).collect());
+            .map(|_| {
+                let mut at = vec![0.0f32; space.dims()];
+                space.coordinates_into(&u, &mut at);
+                at
+            });
         moments.push(Moment {
             t: s.at.duration_since(sent.first).as_secs_f64(),
             target: s.target.clone(),
@@ -264,16 +268,11 @@ pub(super) fn summary(
     Ok(())
 }
 
-/// The sweep as the client saw it, in half-second means of the emotion components.
+/// The sweep as the client saw it, in half-second means of the emotion coordinates.
 fn print_sweep(live: &Live, model: &IcaModel) -> Result<()> {
-    let space: Vec<String> = model
-        .emotion()
-        .space_components()
-        .iter()
-        .map(|k| format!("c{k}"))
-        .collect();
+    let space = model.emotion().axis_names();
     crate::out!(
-        "emotion sweep {} as the client saw it (emotion components {} of the received markers, 0.5 s means):",
+        "emotion sweep {} as the client saw it (emotion axes {} of the received markers, 0.5 s means):",
         live.sweep.join(" -> "),
         space.join(" ")
     );

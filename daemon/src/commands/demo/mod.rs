@@ -125,6 +125,7 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
     let report = Report {
         dir: &dir.join("report"),
         write_model: true,
+        axes: crate::offline::analysis::Axes::default(),
     };
     let regions = session.regions.as_deref();
     let model = analyze_and_write(&model_path, &session.manifest, regions, &report)?;

@@ -78,13 +78,78 @@ fn space_section(report: &Report, levels: &str) -> String {
         r#"<p>Components whose take levels differ between emotions (blocked F test over the
 paired takes, p &lt; 0.001 over all components): {}; emotion axes (emotions explain at least
 half of their levels): {}. Each emotion is a point in this space: the mean over its takes ± the
-spread across them. Edits move every one of these components.</p>
+spread across them.</p>
 <img src="emotion_map.svg" alt="emotion map: takes and emotion levels in the plane of the two strongest emotion directions">
+{}
 {}"#,
         comps.join(", "),
         axes.join(", "),
-        super::map::level_table(report)
+        super::map::level_table(report),
+        fitted_section(space)
     )
+}
+
+/// The axes the edits use (fitted over every component) and whether the emotion components
+/// alone would have been sound axes.
+fn fitted_section(space: &super::space::EmotionSpace) -> String {
+    let mut out = String::from("<h3>Axes of the edits</h3>");
+    if let Some(c) = &space.conditioning {
+        let verdict = if c.ill_conditioned {
+            "<b>Ill-conditioned:</b> "
+        } else {
+            "Well-conditioned: "
+        };
+        let _ = write!(out, "<p>{verdict}{}.</p><ul>", esc(&c.note));
+        let _ = write!(
+            out,
+            "<li>Condition number of the emotions' points on the emotion components: {:.1}              (above {} the components' levels move together)</li>",
+            c.condition,
+            super::space::CONDITION_LIMIT
+        );
+        for (a, b, r) in &c.collinear {
+            let _ = write!(
+                out,
+                "<li>c{a} and c{b} move together over the takes: r = {r:.2}</li>"
+            );
+        }
+        for (k, r) in &c.unstable {
+            let _ = write!(
+                out,
+                "<li>c{k} is not found again by the other training restarts (best match {r:.2})</li>"
+            );
+        }
+        out.push_str("</ul>");
+    }
+    let Some(b) = &space.basis else {
+        out.push_str("<p>The session cannot tell the space's directions apart.</p>");
+        return out;
+    };
+    let tests: Vec<String> = b
+        .tests
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let kept = if t.kept { "kept" } else { "not kept" };
+            format!("e{}: F = {:.1}, p = {:.1e} ({kept})", i + 1, t.f, t.p)
+        })
+        .collect();
+    let _ = write!(
+        out,
+        "<p>The edits use {} axes fitted over every component, so they do not depend on how ICA          split the emotion between components: the directions in which the takes' {} differ          between emotions, each kept while its F test passes ({}). A take's position is read          from its mean with the least noise the takes' means carry; each axis keeps the share of          a take's offset that persists into another emotion (persistence {}).</p>",
+        b.axes.len(),
+        if b.aligned {
+            "levels, with each sentence's content matched frame by frame (DTW),"
+        } else {
+            "mean levels"
+        },
+        tests.join("; "),
+        b.persistence
+            .iter()
+            .map(|p| format!("{p:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    out
 }
 
 /// Escapes text for HTML.

@@ -239,11 +239,60 @@ pub fn timeline_of(report: &Report, takes: &[SessionTake]) -> Vec<TimelineTake> 
         .collect()
 }
 
-/// Stores roles and the emotion space (components, main component, points) in the model.
+/// The axes of the emotion space a model gets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Axes {
+    /// Fitted over every component ([`ica_core::interpret::emotion_basis`]): the space does
+    /// not depend on how ICA split the emotion (issue 34).
+    #[default]
+    Fitted,
+    /// The emotion components themselves, one per axis (the space before issue 34).
+    Components,
+}
+
+impl std::str::FromStr for Axes {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Axes, String> {
+        match s {
+            "fitted" => Ok(Axes::Fitted),
+            "components" => Ok(Axes::Components),
+            _ => Err(format!(
+                "unknown axes {s:?} (expected fitted or components)"
+            )),
+        }
+    }
+}
+
+/// Stores roles and the emotion space (its `axes`, points, main component) in the model.
+/// Fitted axes fall back to the components when the session shows no fitted axis.
 ///
 /// # Errors
 /// A component index outside the model (an internal invariant).
-pub fn write_into_model(model: &mut IcaModel, report: &Report) -> Result<()> {
+pub fn write_into_model(model: &mut IcaModel, report: &Report, axes: Axes) -> Result<()> {
+    let fitted = report.space.as_ref().and_then(|space| {
+        let basis = space.basis.as_ref().filter(|b| !b.axes.is_empty())?;
+        let conditioning = space.conditioning.clone()?;
+        (axes == Axes::Fitted).then_some((space, basis, conditioning))
+    });
+    if let Some((space, basis, conditioning)) = fitted {
+        model.set_fitted_space(
+            space.components.clone(),
+            space.main,
+            report.levels.clone(),
+            ica_core::model::FittedSpace {
+                axes: basis.axes.clone(),
+                moves: basis.moves.clone(),
+                points: basis.points.clone(),
+                persistence: basis.persistence.clone(),
+                conditioning,
+            },
+        )?;
+        for c in &report.components {
+            model.set_role(c.index, c.role)?;
+        }
+        return Ok(());
+    }
     match &report.space {
         Some(space) if !space.components.is_empty() => {
             let main = space.main.expect("a non-empty space has a main component");

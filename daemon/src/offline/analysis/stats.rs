@@ -42,12 +42,16 @@ struct TakeRecord {
     summary: TakeSummary,
     /// The means the emotion space tests ([`take_means`]).
     level: Vec<f64>,
+    /// Its offset from the first take of its sentence in the group, over DTW-aligned frames
+    /// (zeros for that take; `None` when its sentence has no other take).
+    aligned: Option<Vec<f64>>,
 }
 
 /// The analysis of a session so far; see the module docs.
 #[derive(Debug)]
 pub struct SessionStats {
     m: usize,
+    band: usize,
     emotion: EmotionDistanceAcc,
     level: LevelDistanceAcc,
     moments: ComponentMoments,
@@ -64,6 +68,7 @@ impl SessionStats {
         let band = ((longest as f64) * DTW_BAND_SHARE).ceil() as usize;
         Self {
             m,
+            band,
             emotion: EmotionDistanceAcc::new(m, Some(band)),
             level: LevelDistanceAcc::new(m),
             moments: ComponentMoments::new(m),
@@ -79,6 +84,7 @@ impl SessionStats {
     /// A metric that cannot be computed (bad shapes, non-finite components).
     pub fn add_group(&mut self, takes: &[TakeSeries<'_>]) -> Result<()> {
         let m = self.m;
+        let first = self.takes.len();
         let mut means = Vec::with_capacity(takes.len());
         for t in takes {
             self.moments.add_series(t.series)?;
@@ -94,23 +100,64 @@ impl SessionStats {
                     component_means,
                 },
                 level: take_means(t.series, m),
+                aligned: None,
             });
         }
+        // Each take's offset is taken against the first take of its sentence in the group.
+        let reference: Vec<usize> = takes
+            .iter()
+            .map(|t| {
+                takes
+                    .iter()
+                    .position(|r| r.sentence == t.sentence)
+                    .expect("a take is in its own group")
+            })
+            .collect();
         for (i, a) in takes.iter().enumerate() {
             for (j, b) in takes.iter().enumerate().skip(i + 1) {
                 if a.sentence != b.sentence || a.emotion == b.emotion {
                     continue;
                 }
-                let aligned_samples = self.emotion.add_pair(a.series, b.series)?;
+                let pair = self.emotion.add_pair(a.series, b.series)?;
+                if reference[j] == i {
+                    self.takes[first + j].aligned = Some(pair.offset);
+                }
                 self.level.add_means(&means[i], &means[j])?;
                 let summary = PairSummary {
                     sentence: a.sentence.to_string(),
                     a: (a.file.to_string(), a.emotion.to_string()),
                     b: (b.file.to_string(), b.emotion.to_string()),
-                    aligned_samples,
+                    aligned_samples: pair.samples,
                 };
                 self.pairs.push(((a.index, b.index), summary));
             }
+        }
+        self.align_rest(takes, &reference, first)
+    }
+
+    /// Offsets of the takes the pairs did not align against their reference: the reference
+    /// itself (zeros, once its sentence has another take) and takes in its emotion.
+    fn align_rest(
+        &mut self,
+        takes: &[TakeSeries<'_>],
+        reference: &[usize],
+        first: usize,
+    ) -> Result<()> {
+        for (j, t) in takes.iter().enumerate() {
+            let r = reference[j];
+            if self.takes[first + j].aligned.is_some() {
+                continue;
+            }
+            let paired = (0..takes.len()).any(|k| k != j && reference[k] == r);
+            if !paired {
+                continue;
+            }
+            let offset = if r == j {
+                vec![0.0; self.m]
+            } else {
+                interpret::aligned_offset(takes[r].series, t.series, self.m, Some(self.band))?
+            };
+            self.takes[first + j].aligned = Some(offset);
         }
         Ok(())
     }
@@ -131,7 +178,7 @@ impl SessionStats {
         let measured = !self.pairs.is_empty();
         let d_emotion = measured.then(|| self.emotion.finish().per_component);
         let d_level = measured.then(|| self.level.finish());
-        let space = measured.then(|| space_of(&self.takes, m));
+        let space = measured.then(|| space_of(&self.takes, m, &model.quality().stability));
         // Region metrics and roles treat the emotion axes as the emotion set; components that
         // only shift a little with emotion keep their region role.
         let emotion = space.as_ref().map(|s| s.axes.clone()).unwrap_or_default();
@@ -182,17 +229,21 @@ impl SessionStats {
     }
 }
 
-/// The emotion space of the takes' levels.
-fn space_of(takes: &[TakeRecord], m: usize) -> EmotionSpace {
+/// The emotion space of the takes' levels, with its conditioning given each component's
+/// `stability` across training restarts.
+fn space_of(takes: &[TakeRecord], m: usize, stability: &[f64]) -> EmotionSpace {
     let levels: Vec<TakeLevel> = takes
         .iter()
         .map(|t| TakeLevel {
             sentence: t.summary.sentence.clone(),
             emotion: t.summary.emotion.clone(),
             means: t.level.clone(),
+            aligned: t.aligned.clone(),
         })
         .collect();
-    space::emotion_space(&levels, m)
+    let mut space = space::emotion_space(&levels, m);
+    space.conditioning = Some(space::conditioning(&space, &levels, stability));
+    space
 }
 
 /// Roles from the region metrics, given the emotion set.

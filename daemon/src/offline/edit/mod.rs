@@ -162,9 +162,9 @@ pub(crate) struct Plan {
     add: Option<(IcaModel, Series)>,
     /// The live emotion edit (causal low-pass), when `--lowpass` asks for it.
     live: Option<EditState>,
-    /// `--to-emotion` from the take's mean: the emotion components, the point and how far;
-    /// waits for the take's component sums ([`Plan::settle`]).
-    toward: Option<(Vec<usize>, Vec<f32>, f32)>,
+    /// `--to-emotion` from the take's mean: the point and how far; waits for the take's
+    /// component sums ([`Plan::settle`]).
+    toward: Option<(Vec<f32>, f32)>,
 }
 
 /// Sums of each component over a take's frames, in frame order, for the take's mean: the one
@@ -228,7 +228,7 @@ pub(crate) fn plan(request: &EditRequest, model_path: &Path, model: &IcaModel) -
     }
     let amount = request.amount;
     if let Some(text) = &request.to_emotion {
-        let space = emotion_components(model, model_path)?;
+        emotion_components(model, model_path)?;
         let (name, point) = target_point(model, text)?;
         if !(0.0..=1.0).contains(&amount) {
             return Err(BadRequest(format!("--amount {amount} is outside 0..1")).into());
@@ -244,7 +244,7 @@ pub(crate) fn plan(request: &EditRequest, model_path: &Path, model: &IcaModel) -
                 state.set_amount(amount as f32)?;
                 plan.live = Some(state);
             }
-            None => plan.toward = Some((space, goal, amount as f32)),
+            None => plan.toward = Some((goal, amount as f32)),
         }
     }
     Ok(plan)
@@ -256,17 +256,21 @@ impl Plan {
         self.toward.is_some()
     }
 
-    /// Turns a mean-based `--to-emotion` into offsets, from the take's component sums.
+    /// Turns a mean-based `--to-emotion` into offsets, from the take's component sums: the
+    /// take's mean read in the emotion space, moved to its target there.
     pub(crate) fn settle(&mut self, model: &IcaModel, sums: &ComponentSums) {
-        let Some((space, goal, amount)) = self.toward.take() else {
+        let Some((goal, amount)) = self.toward.take() else {
             return;
         };
-        let current: Vec<f32> = space.iter().map(|&k| sums.mean(k)).collect();
-        let mut to = vec![0.0f32; space.len()];
-        ica_core::model::SpaceTarget::new(model.emotion()).target_into(&current, &goal, &mut to);
-        for ((&k, c), t) in space.iter().zip(&current).zip(&to) {
-            self.offsets[k] += amount * (t - c);
-        }
+        let m = model.components();
+        let mut space = ica_core::model::SpaceTarget::new(model.emotion(), m);
+        let means: Vec<f32> = (0..m).map(|k| sums.mean(k)).collect();
+        let mut current = vec![0.0f32; space.dims()];
+        space.coordinates_into(&means, &mut current);
+        let mut to = vec![0.0f32; space.dims()];
+        space.target_into(&current, &goal, &mut to);
+        let delta: Vec<f32> = to.iter().zip(&current).map(|(t, c)| t - c).collect();
+        space.move_into(&delta, amount, &mut self.offsets);
     }
 
     /// Copy & Replace and Copy & Add, which align another take to the whole of this one.
