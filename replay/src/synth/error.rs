@@ -82,6 +82,16 @@ pub enum SynthError {
         /// What it accepts.
         expected: String,
     },
+    /// A variant knob names an emotion the session does not have.
+    #[error("{knob} names emotion {emotion:?}, which is not in the emotion list ({known}): add it to the emotions or fix the name")]
+    UnlistedVariation {
+        /// The knob.
+        knob: &'static str,
+        /// The emotion named.
+        emotion: String,
+        /// The session's emotions, comma separated.
+        known: String,
+    },
     /// A variant knob given twice for one emotion.
     #[error("{knob} is given twice for emotion {emotion:?}")]
     RepeatedVariation {

@@ -93,9 +93,9 @@ impl Variation {
     /// Checks the knobs against the session's emotions and sentence count.
     ///
     /// # Errors
-    /// [`SynthError::BadVariation`] for a value out of range, [`SynthError::UnknownEmotion`]
-    /// for a name not in the session, [`SynthError::DuplicatePoint`]-like repeats as
-    /// [`SynthError::BadVariation`].
+    /// [`SynthError::BadVariation`] for a value out of range,
+    /// [`SynthError::UnlistedVariation`] for a name not in the session,
+    /// [`SynthError::RepeatedVariation`] for an emotion given twice.
     pub fn validate(&self, emotions: &[String], sentences: usize) -> Result<(), SynthError> {
         let range = |knob: &'static str, value: f64, lo: f64, hi: f64| {
             if value.is_finite() && (lo..=hi).contains(&value) {
@@ -125,7 +125,11 @@ impl Variation {
         for (knob, list) in [("takes", &self.takes), ("speech rate", &self.speech_rate)] {
             for (i, nv) in list.iter().enumerate() {
                 if !emotions.contains(&nv.name) {
-                    return Err(SynthError::UnknownEmotion(nv.name.clone()));
+                    return Err(SynthError::UnlistedVariation {
+                        knob,
+                        emotion: nv.name.clone(),
+                        known: emotions.join(", "),
+                    });
                 }
                 if list[..i].iter().any(|o| o.name == nv.name) {
                     return Err(SynthError::RepeatedVariation {

@@ -12,4 +12,5 @@ mod record;
 mod synth;
 mod synth_pins;
 mod synth_space;
+mod synth_variants;
 mod text_formats;
