@@ -114,3 +114,28 @@ fn every_emotion_component_moves_to_its_coordinate_of_the_target() {
     );
     assert_eq!(u[1], 7.0, "components outside the space are left alone");
 }
+
+#[test]
+fn fitted_axes_read_the_low_pass_and_move_along_their_components() {
+    // One axis reading c0 + c1 (halves) and moving both; c2 outside the space.
+    let levels = ica_core::model::EmotionLevels {
+        axes: vec![vec![0.5, 0.5, 0.0]],
+        moves: vec![vec![1.0, 1.0, 0.0]],
+        ..Default::default()
+    };
+    let mut e = EditState::with_space(3, SpaceTarget::new(&levels, 3), 0.5);
+    e.set_ramp(0.0);
+    e.set_target("happy", &[3.0]).expect("one level");
+    e.set_amount(1.0).expect("emotion space");
+    let mut u = [0.0f32; 3];
+    for _ in 0..600 {
+        u = [1.0, 0.0, 4.0];
+        e.apply(DT, &mut u);
+    }
+    // The take reads 0.5 on the axis; reaching 3 moves c0 and c1 by 2.5 each.
+    assert!(
+        (u[0] - 3.5).abs() < 1e-3 && (u[1] - 2.5).abs() < 1e-3,
+        "{u:?}"
+    );
+    assert_eq!(u[2], 4.0, "components outside the space are left alone");
+}

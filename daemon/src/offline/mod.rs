@@ -1,8 +1,9 @@
 //! Offline work over takes and models, as library functions the commands and the demo call:
 //! loading and projecting takes ([`takes`]), preparing captures for training and the model's
 //! quality report ([`training`], streaming long sessions), progress reports ([`progress`]), the
-//! analysis of a paired session ([`analysis`]), edit planning ([`edit`]), and `project` and
-//! `edit` streamed from file to output in blocks ([`streamed`]).
+//! analysis of a paired session ([`analysis`]), edit planning ([`edit`]), real captures cut
+//! into a paired session with a known signal ([`inject`]), and `project` and `edit` streamed
+//! from file to output in blocks ([`streamed`]).
 
 pub mod analysis;
 pub mod edit;

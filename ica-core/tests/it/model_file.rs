@@ -242,3 +242,66 @@ fn malformed_json_reports_line_and_column() {
         "{e}"
     );
 }
+
+/// Issue 34: a fitted emotion space (axes over every component, the moves along them, points
+/// over the axes, how it was found) round-trips; the golden file (no axes) still reads as one
+/// component per axis; misshapen axes are refused.
+#[test]
+fn fitted_emotion_axes_round_trip_and_misshapen_ones_are_refused() {
+    let golden = IcaModel::load(GOLDEN.as_bytes()).expect("golden file loads");
+    assert_eq!(golden.emotion().dims(), 1);
+    assert_eq!(
+        golden.emotion().axis_matrices(2),
+        (vec![1.0, 0.0], vec![1.0, 0.0])
+    );
+    let fitted = |v: &mut Value| {
+        v["emotion"]["components"] = json!([0]);
+        v["emotion"]["axes"] = json!([[0.6, 0.8]]);
+        v["emotion"]["moves"] = json!([[0.6, 0.8]]);
+        v["emotion"]["points"] = json!({
+            "happy": {"level": [1.0], "spread": [0.1], "takes": 3},
+            "frustrated": {"level": [-1.5], "spread": [0.2], "takes": 3}
+        });
+        v["emotion"]["persistence"] = json!([0.25]);
+        v["emotion"]["conditioning"] = json!({
+            "components": [0], "dims": 1, "condition": 1.0, "unstable": [[0, 0.8]],
+            "collinear": [], "ill_conditioned": true, "note": "c0 unstable"
+        });
+    };
+    let mut v = golden_value();
+    fitted(&mut v);
+    let model = load_value(&v).expect("a fitted space loads");
+    let e = model.emotion();
+    assert_eq!((e.dims(), e.axis_names()), (1, vec!["e1".to_string()]));
+    assert_eq!(e.point("frustrated"), Some(vec![-1.5]));
+    assert!(e.conditioning.as_ref().is_some_and(|c| c.ill_conditioned));
+    let mut out = Vec::new();
+    model.save(&mut out).expect("vec writer");
+    assert_eq!(IcaModel::load(out.as_slice()).expect("reloads"), model);
+    for field in ["axes", "moves"] {
+        let err = load_err(|v| {
+            fitted(v);
+            v["emotion"][field] = json!([[0.6, 0.8, 0.0]]);
+        });
+        assert!(
+            matches!(err, ModelError::NonFiniteLevel { .. }),
+            "{field}: 3 weights for 2 components: {err:?}"
+        );
+    }
+    let err = load_err(|v| {
+        fitted(v);
+        v["emotion"]["moves"] = json!([]);
+    });
+    assert!(
+        matches!(err, ModelError::NonFiniteLevel { .. }),
+        "no moves: {err:?}"
+    );
+    let err = load_err(|v| {
+        fitted(v);
+        v["emotion"]["points"]["happy"]["level"] = json!([1.0, 2.0]);
+    });
+    assert!(
+        matches!(err, ModelError::NonFiniteLevel { .. }),
+        "2 levels, 1 axis: {err:?}"
+    );
+}
