@@ -5,7 +5,7 @@
 //! cargo run --example emotion_transfer -- --variants base,intensity --seeds 1,2,3
 //! cargo run --example emotion_transfer -- --capture facial-sing --seeds 1,2,3,4,5
 //! cargo run --example emotion_transfer -- --capture custom --files a.c3d,b.c3d \
-//!     --head root-1,root-2,root-3 --regions r.toml --seeds 1
+//!     --head root-1,root-2,root-3 --regions r.toml --seeds 1 --name mine
 //! ```
 //!
 //! Options: `--emoshift PATH` (default: the `emoshift` built beside this example), `--takes N`
@@ -31,6 +31,7 @@ struct Args {
     exe: Emoshift,
     variants: Vec<String>,
     capture: Option<String>,
+    name: Option<String>,
     files: Vec<PathBuf>,
     head: Vec<String>,
     regions: Option<PathBuf>,
@@ -57,6 +58,7 @@ fn parse() -> Result<Args, String> {
         exe: Emoshift(beside),
         variants: Vec::new(),
         capture: None,
+        name: None,
         files: Vec::new(),
         head: Vec::new(),
         regions: None,
@@ -81,6 +83,7 @@ fn parse() -> Result<Args, String> {
             }
             "--variants" => a.variants = list(&value),
             "--capture" => a.capture = Some(value),
+            "--name" => a.name = Some(value),
             "--files" => a.files = list(&value).into_iter().map(PathBuf::from).collect(),
             "--head" => a.head = list(&value),
             "--regions" => a.regions = Some(value.into()),
@@ -151,6 +154,7 @@ fn main() {
     }
     if let Some(capture) = &args.capture {
         let (files, head, regions) = capture_inputs(&args, capture);
+        let capture = args.name.as_ref().unwrap_or(capture);
         let head: Vec<&str> = head.iter().map(String::as_str).collect();
         for &seed in &args.seeds {
             let params = InjectParams {

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use daemon::offline::inject::InjectParams;
 
 use crate::transfer::{
-    capture_session, describe, pair_errors, prepare_capture, CaptureTruth, Emoshift, Prep,
+    assert_within, capture_session, pair_errors, prepare_capture, CaptureTruth, Emoshift, Prep,
 };
 
 fn fixture(rel: &str) -> PathBuf {
@@ -29,18 +29,7 @@ fn check(name: &str, files: &[PathBuf], head: &[&str], regions: &Path, seeds: &[
         let session = capture_session(files, head, &params);
         let model = prepare_capture(&exe, dir.path(), &session, regions, &Prep::default());
         let errors = pair_errors(&exe, dir.path(), &model, &CaptureTruth(session), 3);
-        eprintln!("{name} seed {seed}: {}", describe(&errors));
-        assert_eq!(errors.len(), 6, "every ordered pair of 3 levels");
-        for e in &errors {
-            assert!(
-                e.mean() <= 0.2 && e.worst() <= 0.25,
-                "{name} seed {seed}: {}->{} mean {:.3}, worst take {:.3}",
-                e.from,
-                e.to,
-                e.mean(),
-                e.worst()
-            );
-        }
+        assert_within(&format!("{name} seed {seed}"), &errors, 3, 0.2, 0.25);
     }
 }
 

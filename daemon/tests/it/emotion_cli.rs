@@ -5,6 +5,26 @@ use std::path::Path;
 
 use crate::common::{ok, p, run};
 
+/// `train` then `analyze --write-model` of the session at `manifest` into `model`, the report
+/// in `report`; returns analyze's output.
+fn train_and_analyze(manifest: &Path, model: &Path, report: &Path) -> String {
+    ok(&["train", "--manifest", p(manifest), "--out", p(model)]);
+    analyze(manifest, model, report)
+}
+
+fn analyze(manifest: &Path, model: &Path, report: &Path) -> String {
+    ok(&[
+        "analyze",
+        "--model",
+        p(model),
+        "--manifest",
+        p(manifest),
+        "--out",
+        p(report),
+        "--write-model",
+    ])
+}
+
 /// Runs a command that must be refused as a usage error (exit code 2) naming `needle`.
 fn usage(args: &[&str], needle: &str) {
     let out = run(args);
@@ -105,19 +125,8 @@ fn inject_cuts_a_real_capture_into_a_paired_session_that_analyses_as_one() {
     .expect("json");
     assert_eq!(truth["cuts"].as_array().map(Vec::len), Some(18));
     assert_eq!(truth["field_mm"], 3.0);
-    let manifest = out.join("session.toml");
     let model = out.join("model.json");
-    ok(&["train", "--manifest", p(&manifest), "--out", p(&model)]);
-    let analysed = ok(&[
-        "analyze",
-        "--model",
-        p(&model),
-        "--manifest",
-        p(&manifest),
-        "--out",
-        p(&out.join("report")),
-        "--write-model",
-    ]);
+    let analysed = train_and_analyze(&out.join("session.toml"), &model, &out.join("report"));
     assert!(analysed.contains("space: 1 axes fitted"), "{analysed}");
     assert!(analysed.contains("conditioning: "), "{analysed}");
     let html = std::fs::read_to_string(out.join("report/report.html")).expect("report");
@@ -171,16 +180,7 @@ fn an_ill_conditioned_component_space_is_reported_with_what_was_done() {
     let model = out.join("model.json");
     ok(&["train", "--manifest", p(&manifest), "--out", p(&model)]);
     let analyse = |report: &str| {
-        let text = ok(&[
-            "analyze",
-            "--model",
-            p(&model),
-            "--manifest",
-            p(&manifest),
-            "--out",
-            p(&out.join(report)),
-            "--write-model",
-        ]);
+        let text = analyze(&manifest, &model, &out.join(report));
         let line = text
             .lines()
             .find(|l| l.starts_with("conditioning: "))

@@ -9,8 +9,8 @@
 use std::path::Path;
 
 use crate::transfer::{
-    analyze, describe, pair_errors, prepare_synth, train, turn_model, variant, Emoshift,
-    PairErrors, Prep, SynthTruth,
+    analyze, assert_within, describe, pair_errors, prepare_synth, train, turn_model, variant,
+    Emoshift, PairErrors, Prep, SynthTruth,
 };
 
 fn emoshift() -> Emoshift {
@@ -29,18 +29,7 @@ fn errors(name: &str, seed: u64, dir: &Path) -> Vec<PairErrors> {
 fn check(name: &str, seed: u64) {
     let dir = tempfile::tempdir().expect("temp dir");
     let errors = errors(name, seed, dir.path());
-    eprintln!("{name} seed {seed}: {}", describe(&errors));
-    assert_eq!(errors.len(), 12, "every ordered pair of 4 emotions");
-    for e in &errors {
-        assert!(
-            e.mean() <= 0.15 && e.worst() <= 0.25,
-            "{name} seed {seed}: {}->{} mean {:.3}, worst take {:.3}",
-            e.from,
-            e.to,
-            e.mean(),
-            e.worst()
-        );
-    }
+    assert_within(&format!("{name} seed {seed}"), &errors, 4, 0.15, 0.25);
 }
 
 #[test]

@@ -477,6 +477,27 @@ pub fn transfer_error(original: &Take, zero: &Take, moved: &Take, truth: &Take) 
     (miss / shift.max(1e-300)).sqrt()
 }
 
+/// Prints `errors` under `label` and fails unless every pair's mean is within `pair` and
+/// every take within `take`, after checking that every ordered pair of `emotions` is there.
+pub fn assert_within(label: &str, errors: &[PairErrors], emotions: usize, pair: f64, take: f64) {
+    eprintln!("{label}: {}", describe(errors));
+    assert_eq!(
+        errors.len(),
+        emotions * (emotions - 1),
+        "{label}: every ordered pair"
+    );
+    for e in errors {
+        assert!(
+            e.mean() <= pair && e.worst() <= take,
+            "{label}: {}->{} mean {:.3}, worst take {:.3}",
+            e.from,
+            e.to,
+            e.mean(),
+            e.worst()
+        );
+    }
+}
+
 /// One line per pair: `a->b mean (worst)`.
 pub fn describe(errors: &[PairErrors]) -> String {
     errors

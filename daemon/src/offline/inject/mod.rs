@@ -8,9 +8,10 @@
 //! frames, and pairs need aligning), plus a known field in head coordinates:
 //! `level · field`, level `i / (levels − 1)` for the `i`-th level. Each level is an "emotion"
 //! (`level1`, `level2`, ...), so the session is paired as a real one is: the same content in
-//! every emotion. The field is smooth over the face ([`field`]), [`InjectParams::field_mm`] RMS
-//! over the face markers at the top level and zero on the head reference; it turns with the
-//! head (the rotation of the reference markers' pose, frame by frame), and gaps stay gaps.
+//! every emotion. The field is smooth over the face (a random affine field and a few bumps,
+//! without any rigid part), [`InjectParams::field_mm`] RMS over the face markers at the top
+//! level and zero on the head reference; it turns with the head (the rotation of the reference
+//! markers' pose, frame by frame), and gaps stay gaps.
 //!
 //! The truth of editing a take to another level is the same cut at that level
 //! ([`InjectedSession::render`]): the known field, turned with the head, times the level
