@@ -15,12 +15,12 @@ mod error;
 mod file;
 mod json_rows;
 mod take;
+mod target;
 
-pub use emotion::{
-    BlendError, Conditioning, EmotionLevels, EmotionPoint, FittedSpace, SpaceTarget,
-};
+pub use emotion::{BlendError, Conditioning, EmotionLevels, EmotionPoint, FittedSpace};
 pub use error::ModelError;
 pub use file::FORMAT_VERSION;
+pub use target::SpaceTarget;
 
 use crate::quality::ModelQuality;
 use crate::report::TrainReport;

@@ -52,6 +52,7 @@ pub mod session_io;
 pub mod sources;
 pub mod space;
 pub mod speech;
+pub mod spread;
 pub mod truth;
 pub mod variation;
 pub mod warp;
@@ -222,13 +223,7 @@ impl Synth {
         let mut mixing = mixing::mixing_matrix(&face, params.layout.soft_nose(), columns);
         let v = &params.variation;
         if v.spread_effects > 0.0 {
-            variation::add_spread_effects(
-                &mut mixing,
-                &face,
-                columns,
-                params.seed,
-                v.spread_effects,
-            );
+            spread::add_spread_effects(&mut mixing, &face, columns, params.seed, v.spread_effects);
         }
         let spoken = params
             .emotions
