@@ -1,5 +1,6 @@
 //! The whole live frame path (decode → map → project → edit → resynthesise → encode) at 109
-//! markers and m = 20, through `Pipeline::handle_datagram`; budget 2 µs a frame (issue 7).
+//! markers and m = 20, as the processing thread runs it: the OSC demux, `Pipeline::handle_frame`,
+//! the compact profile encoded; budget 2 µs a frame (issue 7).
 //! Twice: the bare synthetic model (what `emoshift bench` measures), and the same model with
 //! both glitch checks on (a speed limit and per-marker bounds, as a trained model has), set
 //! loose enough that every sample passes, so the checks' full per-marker work is measured. And
@@ -11,19 +12,56 @@ use std::net::SocketAddr;
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use daemon::engine::monitor::MonitorTap;
-use daemon::engine::pipeline::{Pipeline, PipelineConfig};
-use daemon::loopback::synthetic::{frame_into, labels_datagram, random_model};
 use daemon::serve::monitor::Board;
+use daemon::serve::sinks::osc::encode::{EncodeOnly, Profiles};
+use daemon::serve::sources::osc::OscDemux;
+use daemon::serve::sources::InputCounters;
+use engine::monitor::MonitorTap;
+use engine::pipeline::{Pipeline, PipelineConfig};
+use engine::synthetic::{frame_into, labels_datagram, random_model};
+use engine::{Needs, Processed, Sink};
 use ica_core::model::{CaptureSettings, IcaModel, MarkerBounds};
-use protocol::{encode_frame_into, FrameBuf};
+use protocol::{encode_frame_into, FrameBuf, Profile};
+
+/// The compact profile encoded, then, with the monitor page open, the feed's tap on the
+/// frame clock (120 Hz frames, a 30 Hz schedule: every 4th frame copied and published), as
+/// `serve`'s feed does on the wall clock.
+struct Outputs {
+    compact: EncodeOnly,
+    tap: Option<(MonitorTap, Arc<Board>)>,
+}
+
+impl Sink for Outputs {
+    fn needs(&self) -> Needs {
+        self.compact.needs()
+    }
+
+    fn handle_frame(&mut self, frame: &Processed<'_>) {
+        self.compact.handle_frame(frame);
+        if let Some((tap, board)) = &mut self.tap {
+            let now_us = frame.frame_number() as u64 * 8_333;
+            if board.watched() {
+                if let Some(snap) = tap.handle_stream(now_us, frame.stream) {
+                    board.publish(snap);
+                }
+            }
+        }
+    }
+}
 
 fn bench_model(c: &mut Criterion, name: &str, model: IcaModel, monitor: bool) {
     let model = Arc::new(model);
     let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let mut demux = OscDemux::new(109, Arc::new(InputCounters::named("osc")));
     let peer: SocketAddr = "127.0.0.1:9".parse().expect("literal address");
+    let board = Arc::new(Board::new());
+    board.set_viewers(1);
+    let mut outputs = Outputs {
+        compact: EncodeOnly::new(Profiles::default().with(Profile::Compact), 109),
+        tap: monitor.then(|| (MonitorTap::new(30.0), Arc::clone(&board))),
+    };
     let labels = labels_datagram(&model).expect("valid labels");
-    pipeline.handle_datagram(peer, &labels, &mut |_| {});
+    demux.handle_datagram(peer, &labels, &mut |_| {});
     let mut xyz = vec![0.0; 109 * 3];
     let mut buf = FrameBuf::with_max_markers(109);
     let mut datagrams: Vec<Vec<u8>> = (0..120)
@@ -36,30 +74,17 @@ fn bench_model(c: &mut Criterion, name: &str, model: IcaModel, monitor: bool) {
         })
         .collect();
     let mut n: i32 = 0;
-    let (board, mut tap) = (Board::new(), MonitorTap::new(30.0));
-    board.set_viewers(1);
     c.bench_function(name, |b| {
         b.iter(|| {
             let d = &mut datagrams[n as usize % 120];
             // Frame numbers must increase or the stream drops the frame as stale.
             d[24..28].copy_from_slice(&n.to_be_bytes());
             n += 1;
-            let mut out = 0;
-            let mut last = None;
-            pipeline.handle_datagram(peer, d, &mut |e| {
-                out += e.compact.len();
-                last = Some(e.key);
-            });
-            if monitor && board.watched() {
-                let stream = last.and_then(|k| pipeline.stream(&k));
-                let now_us = n as u64 * 8_333;
-                if let Some(snap) = stream.and_then(|s| tap.handle_stream(now_us, s)) {
-                    board.publish(snap);
-                }
-            }
-            out
+            demux.handle_datagram(peer, d, &mut |f| pipeline.handle_frame(f, &mut outputs));
+            outputs.compact.bytes
         })
     });
+    let mut tap = MonitorTap::new(30.0);
     if monitor {
         // The tap's own work, every call due: one snapshot copied and published.
         let key = pipeline.stream_status()[0].key;

@@ -39,13 +39,11 @@
 
 pub mod cli;
 pub mod commands;
-pub mod engine;
 pub mod exit;
 pub mod logging;
 pub mod loopback;
 pub mod offline;
 pub mod serve;
-pub mod synthetic;
 
 /// `println!` that returns the I/O error instead of panicking, so `emoshift info x | head` ends
 /// quietly when the reader goes away (see [`exit::code_for`], which treats a broken pipe as

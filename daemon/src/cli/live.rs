@@ -64,8 +64,8 @@ pub struct NatNetArgs {
 
 impl NatNetArgs {
     /// These options over the `natnet` keys of a config.
-    pub fn raw(&self, server: Option<String>) -> crate::serve::natnet::RawNatNet {
-        crate::serve::natnet::RawNatNet {
+    pub fn raw(&self, server: Option<String>) -> crate::serve::sources::natnet::RawNatNet {
+        crate::serve::sources::natnet::RawNatNet {
             server,
             data: self.natnet_data.clone(),
             interface: self.natnet_interface.clone(),

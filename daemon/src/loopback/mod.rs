@@ -11,8 +11,8 @@ pub mod motive;
 pub mod receiver;
 pub mod source;
 
-pub use crate::synthetic;
 pub use control::{counter, text, ControlClient};
 pub use daemon::Daemon;
+pub use engine::synthetic;
 pub use receiver::{Collecting, Received, Receiver};
 pub use source::Source;

@@ -11,8 +11,8 @@ use ica_core::project::FrameStatus;
 use replay::session::Session;
 use replay::Take;
 
-use crate::engine::frame::{FrameProcessor, Prepared};
-use crate::engine::layout::LabelMap;
+use engine::frame::{FrameProcessor, Prepared};
+use engine::layout::LabelMap;
 
 /// A take loaded from disk, with where it came from.
 #[derive(Debug, Clone)]

@@ -1,16 +1,22 @@
-//! End-to-end latency per stream, from the source's capture time to the frame processed,
-//! "when the clocks allow": a NatNet frame's mid-exposure through the echo's clock offset, an
-//! OSC frame whose `/mocap/timecode` says its capture time is UTC against the system clock.
-//! Other frames (a source's own clock of unknown epoch) are not measured.
+//! Latency histograms: the one histogram shape every stage uses, and end-to-end latency per
+//! stream, from the source's capture time to the frame processed, "when the clocks allow": the
+//! source places its capture time on this host's clock ([`crate::serve::sources::Arrival`]:
+//! a NatNet frame's mid-exposure through the echo's clock offset, an OSC frame stamped UTC);
+//! other frames (a source's own clock of unknown epoch) are not measured.
 
-use std::time::{Instant, SystemTime, UNIX_EPOCH};
+use std::time::Instant;
 
 use hdrhistogram::Histogram;
-use protocol::CaptureClock;
 
-use super::natnet::Session;
-use super::stats::Stats;
-use crate::engine::pipeline::Emitted;
+/// An empty latency histogram, 1 µs to 60 s at 3 significant digits.
+pub fn histogram() -> Histogram<u64> {
+    Histogram::new_with_bounds(1, 60_000_000, 3).expect("constant bounds are valid")
+}
+
+/// Records one latency in microseconds, saturating at the histogram's top.
+pub fn record(h: &mut Histogram<u64>, us: u64) {
+    h.saturating_record(us.max(1));
+}
 
 /// Per stream id, capture → processed in µs, since the last merge.
 #[derive(Debug, Default)]
@@ -19,34 +25,21 @@ pub(crate) struct StreamLatency {
 }
 
 impl StreamLatency {
-    /// Records frame `e` processed at `processed`, when its capture time can be placed on
-    /// this host's clocks. Allocates only for a stream's first measured frame.
-    pub(crate) fn record(&mut self, e: &Emitted<'_>, natnet: Option<&Session>, processed: Instant) {
-        let capture_us = e.input.header().capture_time_us;
-        let us = match (natnet, e.time.clock) {
-            (Some(s), _) => s
-                .local_instant(capture_us)
-                .and_then(|at| processed.checked_duration_since(at))
-                .map(|d| d.as_micros() as i64),
-            (None, CaptureClock::Utc) => SystemTime::now()
-                .duration_since(UNIX_EPOCH)
-                .ok()
-                .map(|now| now.as_micros() as i64 - capture_us),
-            (None, CaptureClock::Source) => None,
-        };
-        // A negative latency means the clocks disagree: nothing to say.
-        let Some(us) = us.filter(|&us| us >= 0) else {
+    /// Records a frame of stream `id` captured at `captured` (this host's clock) and processed
+    /// at `processed`. Allocates only for a stream's first measured frame.
+    pub(crate) fn record(&mut self, id: i32, captured: Option<Instant>, processed: Instant) {
+        // Captured after processed means the clocks disagree: nothing to say.
+        let Some(d) = captured.and_then(|at| processed.checked_duration_since(at)) else {
             return;
         };
-        let id = e.identity.id;
         let h = match self.streams.iter().position(|(s, _)| *s == id) {
             Some(i) => &mut self.streams[i].1,
             None => {
-                self.streams.push((id, Stats::histogram()));
+                self.streams.push((id, histogram()));
                 &mut self.streams.last_mut().expect("just pushed").1
             }
         };
-        Stats::record(h, us as u64);
+        record(h, d.as_micros() as u64);
     }
 
     /// Adds what was measured into the shared stats' histograms and starts over.

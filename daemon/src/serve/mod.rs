@@ -1,21 +1,24 @@
-//! `emoshift serve`: the live service, the shell around one [`crate::engine::Pipeline`]. It
-//! owns what the engine may not: the tokio runtime, sockets, threads, the clock and files.
+//! `emoshift serve`: the live service, the shell around one [`engine::Pipeline`]. It owns
+//! what the engine may not: the tokio runtime, sockets, threads, the clock and files.
 //!
-//! - [`config`]: TOML + CLI → one validated [`Config`];
-//! - `server`: binds the sockets and runs the tasks (the receive task, the control task, the
-//!   status log, signals); the only code that awaits, with `control`;
+//! - [`sources`]: one folder per input protocol (OSC, NatNet), each turning its protocol into
+//!   the engine's [`engine::SourceFrame`]s;
+//! - [`sinks`]: one folder per output (the OSC profiles, the session recording), each an
+//!   [`engine::Sink`];
+//! - [`config`]: TOML + CLI → one validated [`Config`] ([`config_error`] names a bad key);
+//! - `server`: binds the sockets and runs the tasks (sources, control, the status log,
+//!   signals); the only code that awaits, with `control`;
 //! - `control`: control datagrams → [`command`](self) requests to the processing thread, and
 //!   the replies;
-//! - `processing`: the processing thread: frames through the engine, commands between
-//!   frames, the recording, counters merged into [`stats`];
-//! - `sender`: the processing thread's fan-out to the subscribers;
+//! - [`queue`]: the sources' frames to the processing thread, pooled, latest frame wins;
+//! - `processing`: the processing thread: the sources' frames off the queue through the
+//!   engine to the sinks, commands between frames, counters merged into [`stats`];
 //! - [`arrival`]: when the processing thread polls instead of parking (a steady source's
 //!   beat);
-//! - [`record`]: recordings of the edited stream and the raw input;
-//! - [`monitor`]: the monitor page (HTTP + WebSocket), when `monitor` is set;
-//! - [`net`]: sockets (large receive buffers, connected senders);
-//! - [`natnet`]: OptiTrack Motive's NatNet stream as a source beside the OSC frame socket;
-//! - [`capture`]: `emoshift record`, a live source (OSC or NatNet) captured to one file.
+//! - [`monitor`]: the monitor page (HTTP + WebSocket, and its feed, a sink), when `monitor`
+//!   is set;
+//! - [`net`], [`allow`], [`latency`]: sockets, allow-lists, latency histograms;
+//! - [`capture`]: `emoshift record`, one live source (OSC or NatNet) captured to one file.
 //!
 //! Entry points: [`run`] (bind, then serve until the token is cancelled), or [`bind`] then
 //! [`Bound::run`] to learn the bound addresses first (tests bind `127.0.0.1:0`).
@@ -25,17 +28,17 @@ pub mod arrival;
 pub mod capture;
 mod command;
 pub mod config;
+pub mod config_error;
 mod control;
 mod guard;
-mod latency;
+pub mod latency;
 pub mod monitor;
-pub mod natnet;
 pub mod net;
 pub(crate) mod processing;
-pub mod record;
-mod record_sink;
-mod sender;
+pub mod queue;
 pub(crate) mod server;
+pub mod sinks;
+pub mod sources;
 pub mod stats;
 
 pub use config::Config;

@@ -1,41 +1,43 @@
-//! The only module that awaits. Tasks:
+//! Binds the sockets and runs the tasks (the only module that awaits, with `control`):
 //!
-//! - **receive**: frame socket → pooled buffer → bounded crossbeam channel; when full the
-//!   oldest frame is dropped and counted (latest frame wins);
-//! - **processing** (one blocking thread, [`Processing`]): [`Pipeline`] per frame, then the
-//!   encoded bytes straight to every subscriber ([`Fanout`]), control commands (edits,
-//!   subscriptions, models, recordings) between frames, recording;
+//! - **sources**, one task each ([`super::sources`]): the OSC frame socket, the NatNet link
+//!   when configured; each frame into the processing [`Queue`] (bounded; when full the oldest
+//!   frame is dropped and counted: latest frame wins);
+//! - **processing** (one blocking thread, [`Processing`]): [`Pipeline`] per frame, then every
+//!   sink ([`Outputs`]: the OSC subscribers first, the recording, the monitor feed); control
+//!   commands (edits, subscriptions, models, recordings) between frames;
 //! - **control**: decodes control messages and answers them;
 //! - **stats**: logs the counters every few seconds; **SIGHUP** reloads the model.
 //!
-//! Shutdown: the token stops receive and control; the processing thread drains the queue,
+//! Shutdown: the token stops the sources and control; the processing thread drains the queue,
 //! sends what it processes and closes the recording.
 
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
-use crossbeam_channel::{Receiver, Sender};
+use engine::pipeline::{Pipeline, PipelineConfig};
+use engine::{Performer, SourceFrame};
 use ica_core::model::IcaModel;
 use tokio::net::UdpSocket;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
-use super::allow::AllowList;
 use super::command::Request;
 use super::control::{self, ControlCtx, Guard};
 use super::monitor::{Board, Feed};
-use super::processing::{Channels, InFrame, Processing, Shared};
-use super::sender::Fanout;
+use super::processing::{Processing, Shared};
+use super::queue::Queue;
+use super::sinks::osc::{OscOutput, OscOutputConfig};
+use super::sinks::recording::Recorder;
+use super::sinks::Outputs;
+use super::sources::natnet::{Link, NatNetStatus};
+use super::sources::osc::OscSource;
+use super::sources::{Answer, Arrival, InputCounters};
 use super::stats::Stats;
 use super::Config;
-use crate::engine::pipeline::{Pipeline, PipelineConfig};
-use crate::engine::streams::Performer;
-
-/// Pooled buffers kept for received datagrams.
-const POOL: usize = 256;
 
 /// A server with its sockets bound and its models loaded; [`Bound::run`] serves.
 #[derive(Debug)]
@@ -47,8 +49,8 @@ pub struct Bound {
     config: Config,
     model: Arc<IcaModel>,
     performers: Vec<Performer>,
-    /// The NatNet source's sockets, when one is configured.
-    natnet: Option<super::natnet::Link>,
+    /// The NatNet source's sockets, when one is configured, and its counters.
+    natnet: Option<(Link, Arc<InputCounters>)>,
     /// The monitor page's listener, when the page is served.
     monitor: Option<tokio::net::TcpListener>,
 }
@@ -88,11 +90,13 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
     let control = UdpSocket::bind(config.control)
         .await
         .with_context(|| format!("binding the control socket {}", config.control))?;
-    let natnet = config
-        .natnet
-        .clone()
-        .map(super::natnet::Link::open)
-        .transpose()?;
+    let natnet = match config.natnet.clone() {
+        Some(n) => {
+            let counters = Arc::new(InputCounters::named("natnet"));
+            Some((Link::open(n, Arc::clone(&counters))?, counters))
+        }
+        None => None,
+    };
     let monitor = match config.monitor {
         Some(addr) => Some(super::monitor::bind(addr).await?),
         None => None,
@@ -140,35 +144,26 @@ impl Bound {
     /// A task that failed or panicked.
     pub async fn run(self, shutdown: CancellationToken) -> Result<()> {
         let tracker = TaskTracker::new();
-        let stats = Arc::new(Mutex::new(Stats::new()));
-        if let Ok(mut s) = stats.lock() {
-            s.model = self.config.model.display().to_string();
+        let osc = Arc::new(InputCounters::named("osc"));
+        let mut stats = Stats::new();
+        stats.model = self.config.model.display().to_string();
+        stats.inputs.push(Arc::clone(&osc));
+        if let Some((_, counters)) = &self.natnet {
+            stats.inputs.push(Arc::clone(counters));
         }
-        let (frame_tx, frame_rx) = crossbeam_channel::bounded::<InFrame>(self.config.queue);
-        let (free_tx, free_rx) = crossbeam_channel::bounded::<Vec<u8>>(POOL);
-        let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Request>(64);
+        let stats = Arc::new(Mutex::new(stats));
         let shared = Shared {
             stats: Arc::clone(&stats),
             queue_dropped: Arc::new(AtomicU64::new(0)),
             not_allowed: Arc::new(AtomicU64::new(0)),
-            replies: None,
-            monitor: None,
         };
-        let queue = Queue {
-            tx: frame_tx,
-            rx: frame_rx.clone(),
-            free: free_rx,
-            dropped: Arc::clone(&shared.queue_dropped),
-        };
-        let admission = Admission {
-            allow: self.config.frames_allow.clone(),
-            refused: Arc::clone(&shared.not_allowed),
-        };
-        let channels = Channels {
-            frames: frame_rx,
-            free: free_tx,
-            commands: cmd_rx,
-        };
+        let max_markers = PipelineConfig::default().max_markers;
+        let (queue, ends) = Queue::new(
+            self.config.queue,
+            max_markers,
+            Arc::clone(&shared.queue_dropped),
+        );
+        let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Request>(64);
         let ctx = ControlCtx {
             socket: Arc::new(self.control),
             cmd_tx,
@@ -178,35 +173,35 @@ impl Bound {
             tracker: tracker.clone(),
             guard: Arc::new(Guard::new(&self.config)),
         };
-        let every = self.config.stats_interval;
-        let frames = self.frames;
         let board = Arc::new(Board::new());
         if let Some(listener) = self.monitor {
             let token = self.config.monitor_token.clone();
             let parts = (Arc::clone(&board), ctx.clone(), Arc::clone(&stats));
             super::monitor::spawn(listener, token, parts, &tracker, shutdown.clone())?;
         }
+        let source = OscSource {
+            socket: self.frames,
+            allow: self.config.frames_allow.clone(),
+            not_allowed: Arc::clone(&shared.not_allowed),
+            answer: Arc::new(Answer::new(Some(self.replies))),
+            counters: osc,
+            max_markers,
+        };
         let feed = self.config.monitor.map(|_| Feed::new(board));
-        let processing = processing_thread(
-            (self.model, self.performers, self.config),
-            channels,
-            Shared {
-                replies: Some(self.replies),
-                monitor: feed,
-                ..shared
-            },
-        )?;
+        let (every, poll_window) = (self.config.stats_interval, self.config.poll_window);
+        let pipeline = processing_pipeline(self.model, self.performers, &self.config);
+        let outputs = outputs(&self.config, feed)?;
+        let processing = Processing::new((pipeline, outputs), poll_window, (ends, cmd_rx), shared);
         let processing = tracker.spawn_blocking(move || processing.run());
-        if let Some(link) = self.natnet {
-            let queue = queue.clone();
-            tracker.spawn(super::natnet::source::run(
+        if let Some((link, _)) = self.natnet {
+            tracker.spawn(natnet(
                 link,
-                queue,
+                queue.clone(),
                 Arc::clone(&stats),
                 shutdown.clone(),
             ));
         }
-        tracker.spawn(receive(frames, queue, admission, shutdown.clone()));
+        tracker.spawn(receive(source, queue, shutdown.clone()));
         tracker.spawn(control::run(ctx.clone(), shutdown.clone()));
         tracker.spawn(control::reload_on_sighup(ctx, shutdown.clone()));
         tracker.spawn(log_stats(stats, every, shutdown.clone()));
@@ -217,110 +212,60 @@ impl Bound {
     }
 }
 
-/// The processing thread's state: one engine over the models, the subscribers' sockets.
-fn processing_thread(
-    (model, performers, config): (Arc<IcaModel>, Vec<Performer>, Config),
-    channels: Channels,
-    shared: Shared,
-) -> Result<Processing> {
-    let pipeline = Pipeline::new(
-        model,
-        performers,
-        PipelineConfig {
-            lowpass_s: config.lowpass_s,
-            ..PipelineConfig::default()
-        },
-    );
-    let fanout = Fanout::new(&config)?;
-    Ok(Processing::new(
-        pipeline,
-        fanout,
-        config.poll_window,
-        channels,
-        shared,
-    ))
+/// The engine over the models.
+fn processing_pipeline(
+    model: Arc<IcaModel>,
+    performers: Vec<Performer>,
+    config: &Config,
+) -> Pipeline {
+    let settings = PipelineConfig {
+        lowpass_s: config.lowpass_s,
+        ..PipelineConfig::default()
+    };
+    Pipeline::new(model, performers, settings)
 }
 
-/// The processing queue's ends as a receiving task uses them.
-#[derive(Clone)]
-pub(super) struct Queue {
-    tx: Sender<InFrame>,
-    /// To drop the oldest frame when full.
-    rx: Receiver<InFrame>,
-    /// Buffers handed back by the processing thread.
-    free: Receiver<Vec<u8>>,
-    /// Frames dropped because the queue was full.
-    dropped: Arc<AtomicU64>,
-}
-
-/// Which sources may send frames.
-struct Admission {
-    allow: AllowList,
-    /// Datagrams from other sources, dropped.
-    refused: Arc<AtomicU64>,
-}
-
-/// Receive task: datagrams from allowed sources into the bounded queue, latest frame wins.
-async fn receive(
-    socket: UdpSocket,
-    queue: Queue,
-    admission: Admission,
-    shutdown: CancellationToken,
-) {
-    let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
-    loop {
-        let (len, peer) = tokio::select! {
-            () = shutdown.cancelled() => break,
-            r = socket.recv_from(&mut buf) => match r {
-                Ok(r) => r,
-                // ICMP errors and the like on a UDP socket: nothing to do but go on.
-                Err(e) => {
-                    tracing::trace!(target: "emoshift", error = %e, "frame socket receive error");
-                    continue;
-                }
-            },
-        };
-        if !admission.allow.allows(peer.ip()) {
-            admission.refused.fetch_add(1, Ordering::Relaxed);
-            continue;
-        }
-        let mut bytes = queue.buffer();
-        bytes.extend_from_slice(&buf[..len]);
-        let item = InFrame {
-            peer,
-            bytes,
-            received: Instant::now(),
-            natnet: None,
-        };
-        if !queue.push(item) {
-            return;
-        }
+/// Every output: the OSC subscribers, the session recording, the monitor feed when the page
+/// is served. A new sink is one more line here.
+fn outputs(config: &Config, feed: Option<Feed>) -> Result<Outputs> {
+    let osc = OscOutput::new(&OscOutputConfig {
+        send: config.send.clone(),
+        max_subscribers: config.max_subscribers,
+        max_send_failures: config.max_send_failures,
+        lease: config.lease,
+        max_markers: PipelineConfig::default().max_markers,
+    })?;
+    let mut others: Vec<Box<dyn engine::Sink + Send>> = Vec::new();
+    if let Some(feed) = feed {
+        others.push(Box::new(feed));
     }
+    Ok(Outputs {
+        osc,
+        recorder: Recorder::new(),
+        others,
+    })
 }
 
-impl Queue {
-    /// An empty buffer for a datagram: a pooled one handed back by the processing thread.
-    pub(super) fn buffer(&self) -> Vec<u8> {
-        let mut bytes = self.free.try_recv().unwrap_or_default();
-        bytes.clear();
-        bytes
-    }
+/// The OSC frame socket's task, its frames into the queue.
+async fn receive(source: OscSource, queue: Queue, shutdown: CancellationToken) {
+    let mut sink = |frame: &SourceFrame<'_>, arrival: &Arrival| {
+        queue.push(frame, arrival);
+    };
+    super::sources::osc::run(source, &mut sink, shutdown).await;
+}
 
-    /// Queues `item` for the processing thread, dropping (and counting) the oldest frame
-    /// when full: latest frame wins. `false` once the processing thread is gone.
-    pub(super) fn push(&self, mut item: InFrame) -> bool {
-        loop {
-            match self.tx.try_send(item) {
-                Ok(()) => return true,
-                Err(crossbeam_channel::TrySendError::Full(back)) => {
-                    item = back;
-                    if self.rx.try_recv().is_ok() {
-                        self.dropped.fetch_add(1, Ordering::Relaxed);
-                    }
-                }
-                Err(crossbeam_channel::TrySendError::Disconnected(_)) => return false,
-            }
+/// The NatNet link's task: its frames into the queue, its status into `/status`.
+async fn natnet(link: Link, queue: Queue, stats: Arc<Mutex<Stats>>, shutdown: CancellationToken) {
+    let mut sink = |frame: &SourceFrame<'_>, arrival: &Arrival| {
+        queue.push(frame, arrival);
+    };
+    let mut on_status = |status: &NatNetStatus| {
+        if let Ok(mut s) = stats.lock() {
+            s.natnet = Some(status.clone());
         }
+    };
+    if let Err(e) = link.run(shutdown, &mut sink, &mut on_status).await {
+        tracing::error!(target: "emoshift", error = %format!("{e:#}"), "natnet: the source stopped");
     }
 }
 

@@ -2,11 +2,16 @@
 //! seconds and sent as the `/status` reply.
 
 use std::net::SocketAddr;
+use std::sync::Arc;
 
+use engine::{Counters, StreamStatus};
 use hdrhistogram::Histogram;
 use protocol::{DecodeErrorKind, Profile, StatusValue};
 
-use crate::engine::{Counters, StreamStatus};
+use super::latency;
+use super::sinks::osc::SendCounters;
+use super::sources::natnet::NatNetStatus;
+use super::sources::{InputCounters, InputTotals};
 
 /// One subscriber as `/status` lists it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -27,26 +32,13 @@ pub struct SubscriberStatus {
     pub backing_off: bool,
 }
 
-/// Counters of sending.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct SendCounters {
-    /// Datagrams sent.
-    pub datagrams_sent: u64,
-    /// Sends that failed.
-    pub send_errors: u64,
-    /// Subscribers dropped after repeated failures.
-    pub clients_dropped: u64,
-    /// Times a static target started backing off after repeated failures.
-    pub backoffs: u64,
-    /// Datagrams not sent because the socket's send buffer was full.
-    pub dropped_send_buffer: u64,
-}
-
 /// Everything `/status` reports, merged from the processing thread.
 #[derive(Debug)]
 pub struct Stats {
     /// Processing counters (latest snapshot).
     pub counters: Counters,
+    /// Each source's counters, read as `/status` asks.
+    pub inputs: Vec<Arc<InputCounters>>,
     /// Sender counters.
     pub send: SendCounters,
     /// Received → processed, microseconds.
@@ -72,7 +64,7 @@ pub struct Stats {
     /// Frames from sources outside `frames_allow`.
     pub dropped_not_allowed: u64,
     /// The NatNet source, when one is configured.
-    pub natnet: Option<super::natnet::NatNetStatus>,
+    pub natnet: Option<NatNetStatus>,
     /// Per stream id: end-to-end latency from the source's capture time (NatNet: camera
     /// mid-exposure, through the echo's clock offset; OSC: a UTC capture time), µs.
     pub stream_latency_us: Vec<(i32, Histogram<u64>)>,
@@ -104,13 +96,23 @@ impl Default for Stats {
 impl Stats {
     /// An empty latency histogram, 1 µs to 60 s at 3 significant digits.
     pub fn histogram() -> Histogram<u64> {
-        Histogram::new_with_bounds(1, 60_000_000, 3).expect("constant bounds are valid")
+        latency::histogram()
+    }
+
+    /// Every source's counters, summed.
+    pub fn input(&self) -> InputTotals {
+        let mut total = InputTotals::default();
+        for i in &self.inputs {
+            total.add(&i.snapshot());
+        }
+        total
     }
 
     /// Empty stats.
     pub fn new() -> Stats {
         Stats {
             counters: Counters::default(),
+            inputs: Vec::new(),
             send: SendCounters::default(),
             processed_us: Stats::histogram(),
             sent_us: Stats::histogram(),
@@ -132,31 +134,30 @@ impl Stats {
 
     /// Records one latency in microseconds, saturating at the histogram's top.
     pub fn record(h: &mut Histogram<u64>, us: u64) {
-        h.saturating_record(us.max(1));
+        latency::record(h, us);
     }
 
     /// `(name, value)` pairs in the order `/status/confirm` carries them: the counters, each
     /// stream (`stream/<id>/...`), each subscriber (`subscriber/<n>/...`), the latencies.
     pub fn pairs(&self) -> Vec<(String, StatusValue)> {
-        let c = &self.counters;
+        let (c, i) = (&self.counters, self.input());
         let mut out: Vec<(String, StatusValue)> = [
-            ("frames_in", c.frames_in),
+            ("frames_in", i.frames_in),
             ("frames_out", c.frames_out),
             ("frames_dropped", c.dropped_queue_full),
             ("dropped_duplicate", c.dropped_duplicate),
             ("dropped_stale", c.dropped_stale),
-            ("dropped_no_layout", c.dropped_no_layout),
+            ("dropped_no_layout", i.dropped_no_layout),
             ("dropped_unmatched", c.dropped_unmatched),
             ("dropped_not_allowed", self.dropped_not_allowed),
-            ("frame_errors", c.frame_errors),
-            ("labels_in", c.labels_in),
-            ("labels_refused", c.labels_refused),
+            ("frame_errors", c.frame_errors + self.send.encode_errors),
+            ("labels_in", i.labels_in),
+            ("labels_refused", i.labels_refused),
             ("missing_markers", c.missing_markers),
             ("glitches", c.glitches),
             ("restarts", c.restarts),
             ("model_swaps", c.model_swaps),
-            ("bad_packets", c.bad_total()),
-            ("bad_natnet", c.bad_natnet),
+            ("bad_packets", i.bad_total()),
             ("control_refused", self.control_refused),
             ("datagrams_sent", self.send.datagrams_sent),
             ("send_errors", self.send.send_errors),
@@ -176,7 +177,12 @@ impl Stats {
         .map(|(k, v)| (k.to_string(), int(v)))
         .collect();
         for kind in DecodeErrorKind::ALL {
-            out.push((format!("bad_{}", kind.as_str()), int(c.bad[kind.index()])));
+            out.push((format!("bad_{}", kind.as_str()), int(i.bad[kind.index()])));
+        }
+        // Frames of a binary protocol that did not decode, by source (`bad_natnet`).
+        for source in self.inputs.iter().filter(|s| s.bad_frames_counted()) {
+            let bad = source.snapshot().bad_frames;
+            out.push((format!("bad_{}", source.name), int(bad)));
         }
         out.push(("model".into(), StatusValue::Text(self.model.clone())));
         let recording = self.recording.as_ref().map_or("", |r| r.0.as_str());
@@ -207,20 +213,20 @@ impl Stats {
 
     /// Logs a one-line summary.
     pub fn log(&self) {
-        let c = &self.counters;
+        let (c, i) = (&self.counters, self.input());
         tracing::info!(
             target: "emoshift",
-            frames_in = c.frames_in,
+            frames_in = i.frames_in,
             frames_out = c.frames_out,
             dropped = c.dropped_queue_full
                 + c.dropped_stale
                 + c.dropped_duplicate
-                + c.dropped_no_layout
+                + i.dropped_no_layout
                 + c.dropped_unmatched
                 + self.dropped_not_allowed,
-            labels_refused = c.labels_refused,
+            labels_refused = i.labels_refused,
             control_refused = self.control_refused,
-            bad_packets = c.bad_total(),
+            bad_packets = i.bad_total(),
             missing_markers = c.missing_markers,
             clients = self.clients,
             streams = self.streams,
@@ -294,11 +300,15 @@ mod tests {
     #[test]
     fn status_pairs_name_every_bad_packet_kind_and_the_percentiles() {
         let mut s = Stats::new();
-        s.counters.frames_in = 3;
-        s.counters.bad_packet(DecodeErrorKind::Truncated);
+        let osc = Arc::new(InputCounters::named("osc"));
+        for _ in 0..3 {
+            InputCounters::add(&osc.frames_in);
+        }
+        osc.bad_packet(DecodeErrorKind::Truncated);
+        s.inputs.push(osc);
         Stats::record(&mut s.processed_us, 40);
         s.per_stream.push(StreamStatus {
-            key: crate::engine::streams::StreamKey {
+            key: engine::StreamKey {
                 source: "127.0.0.1:5000".parse().expect("literal address"),
                 layout_id: 2,
             },

@@ -1,19 +1,22 @@
 //! Issue 16: the NatNet input path allocates nothing once warm. 10,000 NatNet frames (two
 //! 109-marker markersets, one performer each, labelled markers telling occlusion, timecode)
-//! through `Pipeline::handle_natnet`, every output profile encoded with the timecode, counted
+//! as the NatNet source decodes them into source frames (`NatNetFrames::handle_datagram`),
+//! through `Pipeline::handle_frame`, every output profile encoded with the timecode, counted
 //! by allocation-counter's global allocator.
 
 use std::net::SocketAddr;
 use std::sync::Arc;
 
-use daemon::engine::natnet::{LayoutIds, Naming, NatNetLayout};
-use daemon::engine::pipeline::{profile_bit, Pipeline, PipelineConfig};
 use daemon::loopback::synthetic::{frame_into, random_model};
+use daemon::serve::sinks::osc::encode::EncodeOnly;
+use daemon::serve::sources::natnet::frames::{LayoutIds, Naming, NatNetFrames, NatNetLayout};
+use engine::pipeline::{Pipeline, PipelineConfig};
+use engine::{Each, Processed, Sink};
 use protocol::natnet::{
     encode_frame_into, FrameOfData, LabeledMarker, MarkerParams, MarkersetDef, ModelDefs,
     NatNetVersion, RigidBodyDef,
 };
-use protocol::{Profile, TimecodeRate};
+use protocol::{FrameBuf, TimecodeRate};
 
 const MARKERS: usize = 109;
 
@@ -21,12 +24,6 @@ const MARKERS: usize = 109;
 fn the_natnet_frame_path_does_not_allocate() {
     let model = Arc::new(random_model(MARKERS, 20, 4));
     let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
-    p.set_wanted(
-        Profile::ALL
-            .into_iter()
-            .map(profile_bit)
-            .fold(0, |a, b| a | b),
-    );
     let sets = ["Alice", "Bob"];
     let defs = ModelDefs {
         markersets: sets
@@ -84,20 +81,30 @@ fn the_natnet_frame_path_does_not_allocate() {
         })
         .collect();
     let mut datagrams = datagrams;
-    let mut bytes_out = 0usize;
-    let mut run = |p: &mut Pipeline, from: i32, count: i32, bytes: &mut usize| {
+    let mut frames = NatNetFrames::new(1_000);
+    let mut buf = FrameBuf::with_max_markers(1_000);
+    let mut encoded = EncodeOnly::all(1_000);
+    let mut timed = 0u64;
+    let mut run = |p: &mut Pipeline, from: i32, count: i32| {
         for n in from..from + count {
             let d = &mut datagrams[n as usize % 16];
             // frame number right after the 4-byte header
             d[4..8].copy_from_slice(&n.to_le_bytes());
-            p.handle_natnet(server, d, &layout, &mut |e| {
-                *bytes += e.compact.len() + e.parts.len() + e.components.len();
-                assert!(e.time.timecode.is_some());
-            });
+            frames
+                .handle_datagram(server, d, &layout, &mut buf, &mut |f| {
+                    p.handle_frame(
+                        f,
+                        &mut Each(|e: &Processed<'_>| {
+                            encoded.handle_frame(e);
+                            timed += u64::from(e.time.timecode.is_some());
+                        }),
+                    );
+                })
+                .expect("decodes");
         }
     };
-    run(&mut p, 0, 200, &mut bytes_out);
-    let info = allocation_counter::measure(|| run(&mut p, 200, 10_000, &mut bytes_out));
+    run(&mut p, 0, 200);
+    let info = allocation_counter::measure(|| run(&mut p, 200, 10_000));
     assert_eq!(
         p.counters.frames_out,
         2 * 10_200,
@@ -107,7 +114,8 @@ fn the_natnet_frame_path_does_not_allocate() {
         p.counters.missing_markers > 0,
         "occluded markers were missing"
     );
-    assert!(bytes_out > 2 * 10_200 * 1_000, "every profile encoded");
+    assert!(encoded.bytes > 2 * 10_200 * 1_000, "every profile encoded");
+    assert_eq!(timed, 2 * 10_200, "every frame with its timecode");
     assert_eq!(
         info.count_total, 0,
         "allocations in 10,000 frames: {info:?}"

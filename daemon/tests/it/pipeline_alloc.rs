@@ -1,30 +1,54 @@
 //! The live frame path allocates nothing once warm: 10,000 frames (109 markers, m = 20, some
-//! markers missing, a live emotion edit gliding, every output profile encoded) through
-//! `Pipeline::handle_datagram`, with the monitor page's tap active (a 30 Hz snapshot of the
-//! stream published to the board as the processing thread does), counted by
+//! markers missing, a live emotion edit gliding, every output profile encoded) as `serve`
+//! runs them: the OSC source's demux, the processing queue (pooled buffers, shared labels),
+//! `Pipeline::handle_frame`, the sinks: every OSC profile encoded, and the monitor page's feed
+//! open (a 30 Hz snapshot of the stream published to the board). Counted by
 //! allocation-counter's global allocator (no `unsafe` here: the workspace forbids it).
 
 use std::net::SocketAddr;
+use std::sync::atomic::AtomicU64;
 use std::sync::Arc;
+use std::time::Instant;
 
-use daemon::engine::monitor::MonitorTap;
-use daemon::engine::pipeline::{profile_bit, Pipeline, PipelineConfig};
 use daemon::loopback::synthetic::{frame_into, random_model};
 use daemon::serve::monitor::Board;
-use protocol::{encode_frame_into, encode_labels_into, Control, FrameBuf, Labels, Profile};
+use daemon::serve::queue::Queue;
+use daemon::serve::sinks::osc::encode::EncodeOnly;
+use daemon::serve::sources::osc::OscDemux;
+use daemon::serve::sources::{Answer, Arrival, InputCounters};
+use engine::monitor::MonitorTap;
+use engine::pipeline::{Pipeline, PipelineConfig};
+use engine::{Needs, Processed, Sink};
+use protocol::{encode_frame_into, encode_labels_into, Control, FrameBuf, Labels};
 
 const MARKERS: usize = 109;
+
+/// Every profile encoded, then the monitor tap on the frame clock (every 4th frame at 120 Hz).
+struct Outputs {
+    encoded: EncodeOnly,
+    tap: MonitorTap,
+    board: Board,
+    published: u64,
+}
+
+impl Sink for Outputs {
+    fn needs(&self) -> Needs {
+        self.encoded.needs()
+    }
+
+    fn handle_frame(&mut self, frame: &Processed<'_>) {
+        self.encoded.handle_frame(frame);
+        let now_us = frame.frame_number() as u64 * 8_333;
+        if let Some(snap) = self.tap.handle_stream(now_us, frame.stream) {
+            self.published += u64::from(self.board.publish(snap));
+        }
+    }
+}
 
 #[test]
 fn the_frame_path_does_not_allocate() {
     let model = Arc::new(random_model(MARKERS, 20, 4));
     let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
-    p.set_wanted(
-        Profile::ALL
-            .into_iter()
-            .map(profile_bit)
-            .fold(0, |a, b| a | b),
-    );
     for c in [
         Control::Target("happy".into()),
         Control::Amount(0.8),
@@ -39,6 +63,10 @@ fn the_frame_path_does_not_allocate() {
     ] {
         p.handle_edit(&c).expect("valid edit");
     }
+    let counters = Arc::new(InputCounters::named("osc"));
+    let mut demux = OscDemux::new(1_000, Arc::clone(&counters));
+    let (queue, ends) = Queue::new(64, 1_000, Arc::new(AtomicU64::new(0)));
+    let answer = Arc::new(Answer::new(None));
     let peer: SocketAddr = "127.0.0.1:7000".parse().expect("literal");
     let mut labels = Vec::new();
     let names = model.labels().to_vec();
@@ -50,10 +78,10 @@ fn the_frame_path_does_not_allocate() {
         &mut labels,
     )
     .expect("labels");
-    p.handle_datagram(peer, &labels, &mut |_| {});
+    demux.handle_datagram(peer, &labels, &mut |_| {});
     // 16 distinct frames, every fourth with three markers missing.
     let mut buf = FrameBuf::with_max_markers(MARKERS);
-    let datagrams: Vec<Vec<u8>> = (0..16)
+    let mut datagrams: Vec<Vec<u8>> = (0..16)
         .map(|f| {
             let mut xyz = vec![0.0f32; MARKERS * 3];
             frame_into(&model, f, &mut xyz);
@@ -67,40 +95,49 @@ fn the_frame_path_does_not_allocate() {
             d
         })
         .collect();
-    let mut datagrams = datagrams;
-    let mut bytes_out = 0usize;
     // The monitor page open: its tap copies every 4th frame and publishes it.
-    let board = Board::new();
-    board.set_viewers(1);
-    let mut tap = MonitorTap::new(30.0);
-    let mut published = 0u64;
-    let mut run = |p: &mut Pipeline, from: i32, count: i32, bytes: &mut usize| {
+    let mut out = Outputs {
+        encoded: EncodeOnly::all(1_000),
+        tap: MonitorTap::new(30.0),
+        board: Board::new(),
+        published: 0,
+    };
+    out.board.set_viewers(1);
+    let mut run = |p: &mut Pipeline, out: &mut Outputs, from: i32, count: i32| {
         for n in from..from + count {
             let d = &mut datagrams[n as usize % 16];
             // frame number after "/mocap/frame\0\0\0\0" and ",ihbb\0\0\0"
             d[24..28].copy_from_slice(&n.to_be_bytes());
-            let mut last = None;
-            p.handle_datagram(peer, d, &mut |e| {
-                last = Some(e.key);
-                *bytes += e.compact.len() + e.parts.len() + e.components.len()
+            let received = Instant::now();
+            // The OSC source's task: demux, then each frame copied into the queue.
+            demux.handle_datagram(peer, d, &mut |frame| {
+                let arrival = Arrival {
+                    received,
+                    captured: None,
+                    answer: Some(Arc::clone(&answer)),
+                    announced_rate_hz: None,
+                };
+                queue.push(frame, &arrival);
             });
-            let stream = last
-                .and_then(|key| p.stream(&key))
-                .expect("a frame went out");
-            let now_us = n as u64 * 8_333;
-            if let Some(snap) = tap.handle_stream(now_us, stream) {
-                published += u64::from(board.publish(snap));
-            }
+            // The processing thread: off the queue, through the engine, the buffer back.
+            let item = ends.frames.try_recv().expect("queued");
+            p.handle_frame(&item.source(), out);
+            let _ = ends.free.try_send(item.into_buffer());
         }
     };
-    run(&mut p, 0, 200, &mut bytes_out);
-    let info = allocation_counter::measure(|| run(&mut p, 200, 10_000, &mut bytes_out));
+    run(&mut p, &mut out, 0, 200);
+    let info = allocation_counter::measure(|| run(&mut p, &mut out, 200, 10_000));
     assert_eq!(p.counters.frames_out, 10_200, "every frame processed");
+    assert_eq!(counters.snapshot().frames_in, 10_200, "every frame decoded");
     assert!(
-        published >= 10_200 / 5,
-        "the tap published {published} snapshots"
+        out.published >= 10_200 / 5,
+        "the tap published {} snapshots",
+        out.published
     );
-    assert!(bytes_out > 10_200 * 1_000, "every profile encoded");
+    assert!(
+        out.encoded.bytes > 10_200 * 1_000 && out.encoded.errors == 0,
+        "every profile encoded"
+    );
     assert_eq!(
         info.count_total, 0,
         "allocations in 10,000 frames: {info:?}"

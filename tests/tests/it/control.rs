@@ -39,7 +39,7 @@ async fn an_alpha_change_glides_in_over_the_ramp() {
     assert_eq!(after.len(), 60);
 
     // The unedited component, from the same processor offline.
-    let mut proc = daemon::engine::frame::FrameProcessor::new(&m.model);
+    let mut proc = engine::frame::FrameProcessor::new(&m.model);
     let mut u = vec![0.0; COMPONENTS];
     let base: Vec<f32> = frames
         .iter()

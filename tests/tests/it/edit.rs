@@ -3,9 +3,9 @@
 
 use std::time::Duration;
 
-use daemon::engine::edit_state::{EditState, DEFAULT_LOWPASS_S};
-use daemon::engine::layout::LabelMap;
 use daemon::offline;
+use engine::edit_state::{EditState, DEFAULT_LOWPASS_S};
+use engine::layout::LabelMap;
 use ica_core::edit::FrameEdit;
 use protocol::{Control, Profile, Reply};
 

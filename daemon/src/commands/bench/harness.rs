@@ -18,7 +18,7 @@ use crate::loopback::{Collecting, ControlClient, Daemon, Received, Receiver};
 use crate::serve::config::RawConfig;
 use crate::serve::net::bind_receiver_std;
 use crate::serve::stats::Stats;
-use crate::synthetic::frame_into;
+use engine::synthetic::frame_into;
 
 /// What the receivers saw.
 pub(super) struct Seen {

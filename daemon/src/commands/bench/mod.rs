@@ -27,12 +27,15 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
+use engine::pipeline::{Pipeline, PipelineConfig};
+use engine::synthetic::{frame_into, labels_datagram, random_model};
 use ica_core::model::IcaModel;
-use protocol::{encode_frame_into, FrameBuf};
+use protocol::{encode_frame_into, FrameBuf, Profile};
 
 use crate::cli::BenchArgs;
-use crate::engine::pipeline::{Pipeline, PipelineConfig};
-use crate::synthetic::{frame_into, labels_datagram, random_model};
+use crate::serve::sinks::osc::encode::{EncodeOnly, Profiles};
+use crate::serve::sources::osc::OscDemux;
+use crate::serve::sources::InputCounters;
 use harness::{through_daemon, through_relay, Run};
 
 const MARKERS: usize = 109;
@@ -213,13 +216,20 @@ fn print_max_rate(max: &Run) -> Result<()> {
     Ok(())
 }
 
-/// Frames through one [`Pipeline`] back to back: median µs/frame over batches, frames/s.
+/// Frames through the processing thread's path back to back (the OSC demux, one
+/// [`Pipeline`], the compact profile encoded): median µs/frame over batches, frames/s.
 fn processing_rate(model: &IcaModel) -> Result<(f64, f64)> {
     let model = Arc::new(model.clone());
     let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
-    let peer: SocketAddr = "127.0.0.1:9".parse()?;
+    let mut demux = OscDemux::new(MARKERS, Arc::new(InputCounters::named("osc")));
+    let mut compact = EncodeOnly::new(Profiles::default().with(Profile::Compact), MARKERS);
+    let mut frame_path = |d: &[u8]| {
+        demux.handle_datagram(peer_addr(), d, &mut |f| {
+            pipeline.handle_frame(f, &mut compact)
+        });
+    };
     let mut d = labels_datagram(&model)?;
-    pipeline.handle_datagram(peer, &d, &mut |_| {});
+    frame_path(&d);
     let mut xyz = vec![0.0f32; MARKERS * 3];
     frame_into(&model, 3, &mut xyz);
     let mut buf = FrameBuf::with_max_markers(MARKERS);
@@ -235,7 +245,7 @@ fn processing_rate(model: &IcaModel) -> Result<(f64, f64)> {
             n += 1;
             // frame number: after "/mocap/frame\0..." (16) and ",ihbb\0\0\0" (8)
             d[24..28].copy_from_slice(&n.to_be_bytes());
-            pipeline.handle_datagram(peer, &d, &mut |_| {});
+            frame_path(&d);
         }
         per_frame.push(t.elapsed().as_secs_f64() * 1e6 / batch as f64);
     }
@@ -249,4 +259,9 @@ fn processing_rate(model: &IcaModel) -> Result<(f64, f64)> {
         );
     }
     Ok((per_frame[batches / 2], (batch * batches) as f64 / total))
+}
+
+/// The source address of [`processing_rate`]'s frames.
+fn peer_addr() -> SocketAddr {
+    SocketAddr::from(([127, 0, 0, 1], 9))
 }

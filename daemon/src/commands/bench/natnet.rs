@@ -19,7 +19,7 @@ use crate::loopback::motive::{Motive, MotiveOptions};
 use crate::loopback::source::{drive, Due};
 use crate::loopback::{ControlClient, Daemon};
 use crate::serve::config::RawConfig;
-use crate::synthetic::frame_into;
+use engine::synthetic::frame_into;
 
 /// A free multicast port on loopback.
 fn free_port() -> Result<u16> {

@@ -183,7 +183,7 @@ fn send_take(take: &Take, to: SocketAddr, total: usize) -> Result<Sent> {
 /// model units).
 fn measure(model: &IcaModel, seen: &[Seen], sent: &Sent, sweep: &[String], rate_hz: f64) -> Live {
     let mut latency_us = Stats::histogram();
-    let mut processor = crate::engine::frame::FrameProcessor::new(model);
+    let mut processor = engine::frame::FrameProcessor::new(model);
     let mut u = vec![0.0f32; model.components()];
     let space = ica_core::model::SpaceTarget::new(model.emotion(), model.components());
     let mut moments = Vec::with_capacity(seen.len());

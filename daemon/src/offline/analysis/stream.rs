@@ -11,7 +11,7 @@
 //! 3. The few takes the timeline chart draws (at most ten), again: which ones depends on the
 //!    emotion levels, also known only at the end.
 //!
-//! [`FrameProcessor`]: crate::engine::frame::FrameProcessor
+//! [`FrameProcessor`]: engine::frame::FrameProcessor
 
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -26,9 +26,9 @@ use replay::Take;
 mod output;
 
 pub(crate) use self::output::Output;
-use crate::engine::edit_state::EditState;
 use crate::offline::analysis::DTW_BAND_SHARE;
 use crate::offline::{self, ModelFrames, Projected};
+use engine::edit_state::EditState;
 
 /// What to do to a take; every field is optional and they combine.
 #[derive(Debug, Clone, Default)]

@@ -3,7 +3,7 @@
 use anyhow::{bail, Result};
 use replay::Take;
 
-use crate::engine::LabelMap;
+use engine::LabelMap;
 
 /// The output take: the model's markers edited (gaps filled from the model unless
 /// `keep_gaps`), followed by the take's extra markers unchanged, so nothing the user gave is

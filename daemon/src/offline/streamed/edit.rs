@@ -8,9 +8,9 @@ use ica_core::model::IcaModel;
 use replay::blocks::TakeWriter;
 
 use super::{label_map, run_pass, source_notices, Frame, FrameSink, PendingOut, Source};
-use crate::engine::frame::FrameProcessor;
 use crate::offline::edit::{plan, ComponentSums, EditRequest, FrameEditor, Output};
 use crate::offline::progress::Progress;
+use engine::frame::FrameProcessor;
 
 /// What [`edit_file`] did.
 #[derive(Debug, Clone, PartialEq, Eq)]

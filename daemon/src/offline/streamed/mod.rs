@@ -25,10 +25,10 @@ pub use project::{project_file, ProjectSummary};
 use anyhow::{Context, Result};
 use ica_core::model::IcaModel;
 
-use crate::engine::frame::{FrameProcessor, Prepared};
-use crate::engine::LabelMap;
 use crate::offline::progress::Progress;
 use crate::offline::takes::frames_in_model_order;
+use engine::frame::{FrameProcessor, Prepared};
+use engine::LabelMap;
 pub(crate) use output::PendingOut;
 pub(crate) use source::Source;
 

@@ -37,9 +37,9 @@ pub use head::{HeadChoice, DEFAULT_HEAD_PATTERNS};
 pub use model::{train, PrepReport, Stage, TrainOptions, Trained};
 pub use stream::{train_files, StreamOptions, IN_MEMORY_FRAMES, SAMPLE_FRAMES};
 
-use crate::engine::frame::FramePrep;
-use crate::engine::layout::LabelMap;
 use crate::offline::{self, LoadedTake, ModelFrames};
+use engine::frame::FramePrep;
+use engine::layout::LabelMap;
 
 /// The glitch speed limit.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,25 +1,26 @@
-//! `emoshift record`: a live source captured to one file for training, the shell around
-//! [`take::Take`]. The source is an OSC frame socket (`/mocap/labels`, `/mocap/frame`, and
-//! `/mocap/timecode` when sent), or a NatNet server through the same [`Link`] `serve` uses,
-//! each markerset a stream. It stops after `--frames` or `--seconds`, or on Ctrl-C, and the
-//! file is complete either way. While nothing arrives it says so, once per quiet spell.
+//! `emoshift record`: a live source captured to one file for training (a "capture"; the
+//! service's `/record/start` is a "session recording"), the shell around [`take::Take`]. The
+//! source is the same as `serve`'s ([`super::sources`]): an OSC frame socket
+//! (`/mocap/labels`, `/mocap/frame`, and `/mocap/timecode` when sent) or a NatNet server, each
+//! markerset a stream. It stops after `--frames` or `--seconds`, or on Ctrl-C, and the file is
+//! complete either way. While nothing arrives it says so, once per quiet spell.
 
 pub mod take;
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
+use std::sync::atomic::AtomicU64;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use protocol::{
-    decode_frame_into, decode_labels, decode_timecode, messages, Address, FrameBuf, FrameTime,
-    LayoutBook, Limits,
-};
+use engine::SourceFrame;
 use tokio_util::sync::CancellationToken;
 
-use super::natnet::{Link, NatNetConfig, NatNetStatus, Session};
-use crate::engine::natnet::NatNetFrames;
+use super::allow::AllowList;
+use super::sources::natnet::{Link, NatNetConfig, NatNetStatus};
+use super::sources::osc::OscSource;
+use super::sources::{Answer, Arrival, InputCounters};
 use take::{Captured, Incoming, Take};
 
 /// Silence after which `record` says nothing is arriving.
@@ -102,9 +103,29 @@ pub async fn run(
         quiet_told: false,
         error: None,
     });
+    let stop = shutdown.child_token();
+    let mut sink = |frame: &SourceFrame<'_>, arrival: &Arrival| {
+        let stream = match frame.performer {
+            Some(name) => name.to_string(),
+            None => format!("{}/{}", frame.key.source, frame.key.layout_id),
+        };
+        let mut s = lock(&state);
+        s.push(&Incoming {
+            stream: &stream,
+            labels: frame.labels,
+            frame: frame.frame,
+            header: frame.frame.header(),
+            timecode: frame.time.timecode,
+            announced_rate_hz: arrival.announced_rate_hz,
+            received: arrival.received,
+        });
+        if s.done(&config) {
+            stop.cancel();
+        }
+    };
     match &config.source {
-        Source::Osc(addr) => osc(*addr, &config, &state, &shutdown, notice).await?,
-        Source::NatNet(n) => natnet(n.clone(), &config, &state, &shutdown, notice).await?,
+        Source::Osc(addr) => osc(*addr, &state, &stop, &mut sink, notice).await?,
+        Source::NatNet(n) => natnet(n.clone(), &state, &stop, &mut sink, notice).await?,
     }
     let state = state
         .into_inner()
@@ -117,127 +138,68 @@ pub async fn run(
     state.take.finish()
 }
 
+/// The OSC source on `addr` until `stop`, with a quiet notice while nothing comes.
 async fn osc(
     addr: SocketAddr,
-    config: &CaptureConfig,
     state: &Mutex<State>,
-    shutdown: &CancellationToken,
+    stop: &CancellationToken,
+    sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
     notice: &mut (dyn FnMut(&str) + Send),
 ) -> Result<()> {
     let socket = super::net::bind_receiver(addr)
         .with_context(|| format!("binding the frame socket {addr}"))?;
     let bound = socket.local_addr()?;
     tracing::info!(target: "emoshift", listen = %bound, "record: waiting for frames");
-    let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
-    let mut layouts = LayoutBook::new(64);
-    let mut frame = FrameBuf::new();
+    let source = OscSource {
+        socket,
+        allow: AllowList::anyone(),
+        not_allowed: Arc::new(AtomicU64::new(0)),
+        answer: Arc::new(Answer::new(None)),
+        counters: Arc::new(InputCounters::named("osc")),
+        max_markers: protocol::MAX_FRAME_MARKERS,
+    };
     let started = Instant::now();
-    let mut tick = tokio::time::interval(Duration::from_millis(250));
-    loop {
-        let (n, peer) = tokio::select! {
-            () = shutdown.cancelled() => return Ok(()),
-            _ = tick.tick() => {
-                let mut s = lock(state);
-                let line = s.quiet_notice(started, || format!(
+    let quiet = async {
+        let mut tick = tokio::time::interval(Duration::from_millis(250));
+        loop {
+            tokio::select! {
+                () = stop.cancelled() => return,
+                _ = tick.tick() => {}
+            }
+            let line = lock(state).quiet_notice(started, || {
+                format!(
                     "nothing has arrived on {bound} for {} s: is the source sending \
-                     /mocap/labels and /mocap/frame here?", QUIET.as_secs()));
-                drop(s);
-                if let Some(line) = line { notice(&line) }
-                continue;
-            }
-            r = socket.recv_from(&mut buf) => match r { Ok(r) => r, Err(_) => continue },
-        };
-        let Ok(msgs) = messages(&buf[..n], &Limits::default()) else {
-            continue;
-        };
-        let mut time = FrameTime::default();
-        for m in msgs.clone() {
-            if Address::parse(m.address) == Some(Address::Timecode) {
-                time = decode_timecode(m.bytes).unwrap_or_default();
+                     /mocap/labels and /mocap/frame here?",
+                    QUIET.as_secs()
+                )
+            });
+            if let Some(line) = line {
+                notice(&line);
             }
         }
-        for m in msgs {
-            match Address::parse(m.address) {
-                Some(Address::Labels) => {
-                    if let Ok(l) = decode_labels(m.bytes) {
-                        layouts.handle_labels(&peer, l);
-                    }
-                }
-                Some(Address::Frame) => {
-                    let Ok(header) = decode_frame_into(m.bytes, &mut frame) else {
-                        continue;
-                    };
-                    let Some(labels) = layouts.layout_for(&peer, header.marker_count) else {
-                        continue;
-                    };
-                    let stream = format!("{peer}/{}", labels.layout_id);
-                    lock(state).push(&Incoming {
-                        stream: &stream,
-                        labels: &labels.names,
-                        frame: &frame,
-                        header,
-                        timecode: time.timecode,
-                        announced_rate_hz: None,
-                        received: Instant::now(),
-                    });
-                }
-                _ => {}
-            }
-        }
-        if lock(state).done(config) {
-            return Ok(());
-        }
-    }
+    };
+    tokio::join!(super::sources::osc::run(source, sink, stop.clone()), quiet);
+    Ok(())
 }
 
+/// The NatNet source until `stop`, with a quiet notice while nothing comes.
 async fn natnet(
     n: NatNetConfig,
-    config: &CaptureConfig,
     state: &Mutex<State>,
-    shutdown: &CancellationToken,
+    stop: &CancellationToken,
+    sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
     notice: &mut (dyn FnMut(&str) + Send),
 ) -> Result<()> {
     let server = n.server;
-    let link = Link::open(n)?;
-    let stop = shutdown.child_token();
-    let mut frames = NatNetFrames::new(protocol::MAX_FRAME_MARKERS);
-    let mut buf = FrameBuf::new();
+    let link = Link::open(n, Arc::new(InputCounters::named("natnet")))?;
     let started = Instant::now();
-    let mut on_frame = |bytes: &[u8], received: Instant, session: &Arc<Session>| {
-        let layout = &session.layout;
-        if let Err(e) = frames.decode(bytes, layout) {
-            tracing::debug!(target: "emoshift", error = %e, "record: a NatNet frame did not decode");
-            return;
-        }
-        let time = frames.time(layout);
-        let mut s = lock(state);
-        for set in &layout.markersets {
-            let Some(header) = frames.markerset_into(set, layout, &mut buf) else {
-                continue;
-            };
-            s.push(&Incoming {
-                stream: &set.name,
-                labels: &set.labels,
-                frame: &buf,
-                header,
-                timecode: time.timecode,
-                announced_rate_hz: session.announced_rate_hz,
-                received,
-            });
-        }
-        if s.done(config) {
-            stop.cancel();
-        }
-    };
     let mut on_status = |st: &NatNetStatus| {
-        let mut s = lock(state);
-        let line = s.quiet_notice(started, || natnet_quiet(server, st));
-        drop(s);
+        let line = lock(state).quiet_notice(started, || natnet_quiet(server, st));
         if let Some(line) = line {
             notice(&line);
         }
     };
-    link.run(stop.clone(), &mut on_frame, &mut on_status).await
+    link.run(stop.clone(), sink, &mut on_status).await
 }
 
 /// Why nothing arrives from a NatNet server, as far as the session can tell.

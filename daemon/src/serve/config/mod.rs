@@ -11,12 +11,13 @@ use protocol::Profile;
 use serde::Deserialize;
 
 use super::allow::AllowList;
+pub use super::config_error::ConfigError;
 
 mod values;
 pub use values::parse_send;
 use values::{addr, check, performer, secret};
 
-pub use crate::engine::PerformerConfig;
+pub use engine::PerformerConfig;
 
 /// Default frame port.
 pub const DEFAULT_LISTEN: &str = "127.0.0.1:9000";
@@ -88,7 +89,7 @@ pub struct RawConfig {
     pub max_model_mb: Option<u64>,
     /// Named performers.
     pub performers: Vec<RawPerformer>,
-    /// NatNet server to take frames from, `IP[:PORT]` (see [`super::natnet`]).
+    /// NatNet server to take frames from, `IP[:PORT]` (see [`super::sources::natnet`]).
     pub natnet: Option<String>,
     /// Where NatNet frames arrive (multicast group or local address), `IP:PORT`.
     pub natnet_data: Option<String>,
@@ -143,72 +144,11 @@ pub struct Config {
     /// Performers.
     pub performers: Vec<PerformerConfig>,
     /// The NatNet source, if any.
-    pub natnet: Option<super::natnet::NatNetConfig>,
+    pub natnet: Option<super::sources::natnet::NatNetConfig>,
     /// The monitor page's address, if it is served.
     pub monitor: Option<SocketAddr>,
     /// The monitor page's token, if one is set.
     pub monitor_token: Option<String>,
-}
-
-/// Why a configuration is refused; each names the key and the value.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ConfigError {
-    /// The TOML does not parse, has an unknown key or a value of the wrong type.
-    #[error("line {line}{}: {message}", key.as_ref().map(|k| format!(", key {k}")).unwrap_or_default())]
-    Toml {
-        /// 1-based line of the problem (0 when toml gives no place).
-        line: usize,
-        /// The key on that line, if it has one.
-        key: Option<String>,
-        /// What toml says.
-        message: String,
-    },
-    /// An allow-list entry that is not a network.
-    #[error("{key}: {message}")]
-    Network {
-        /// Key.
-        key: &'static str,
-        /// Why.
-        message: String,
-    },
-    /// An address that does not parse.
-    #[error("{key}: {value:?} is not an IP:PORT address")]
-    Address {
-        /// Key.
-        key: &'static str,
-        /// Value.
-        value: String,
-    },
-    /// `send` with an unknown profile.
-    #[error("send: {value:?}: unknown profile, expected compact, flat-split or components")]
-    Profile {
-        /// Value.
-        value: String,
-    },
-    /// A number out of range.
-    #[error("{key}: {value} is out of range ({range})")]
-    Range {
-        /// Key.
-        key: &'static str,
-        /// Value, printed.
-        value: String,
-        /// Accepted range.
-        range: &'static str,
-    },
-    /// No model given.
-    #[error("no model: pass --model model.json or set model in the config")]
-    NoModel,
-    /// The frame and control sockets on one UDP port.
-    #[error(
-        "listen {listen} and control {control} share a port: the frame socket and the control \
-         socket each need their own"
-    )]
-    SharedPort {
-        /// The frame socket.
-        listen: SocketAddr,
-        /// The control socket.
-        control: SocketAddr,
-    },
 }
 
 impl RawConfig {
@@ -265,10 +205,10 @@ impl RawConfig {
             send,
             max_subscribers: self
                 .max_subscribers
-                .unwrap_or(crate::engine::clients::DEFAULT_MAX_DYNAMIC),
+                .unwrap_or(engine::subscribers::DEFAULT_MAX_DYNAMIC),
             max_send_failures: self
                 .max_send_failures
-                .unwrap_or(crate::engine::clients::DEFAULT_MAX_FAILURES),
+                .unwrap_or(engine::subscribers::DEFAULT_MAX_FAILURES),
             lowpass_s: numbers.lowpass_s,
             queue: numbers.queue,
             poll_window: numbers.poll_window,
@@ -283,7 +223,7 @@ impl RawConfig {
                 .into_iter()
                 .map(performer)
                 .collect::<Result<_, _>>()?,
-            natnet: super::natnet::RawNatNet {
+            natnet: super::sources::natnet::RawNatNet {
                 server: self.natnet,
                 data: self.natnet_data,
                 interface: self.natnet_interface,
@@ -304,7 +244,7 @@ impl RawConfig {
     fn numbers(&self) -> Result<Numbers, ConfigError> {
         let lowpass_s = self
             .lowpass_s
-            .unwrap_or(crate::engine::edit_state::DEFAULT_LOWPASS_S);
+            .unwrap_or(engine::edit_state::DEFAULT_LOWPASS_S);
         check(
             "lowpass_s",
             lowpass_s.is_finite() && lowpass_s >= 0.0,
@@ -324,7 +264,7 @@ impl RawConfig {
         )?;
         let lease = self
             .subscription_lease_s
-            .unwrap_or(crate::engine::clients::DEFAULT_LEASE.as_secs_f64());
+            .unwrap_or(engine::subscribers::DEFAULT_LEASE.as_secs_f64());
         let ok = lease.is_finite() && (1.0..=3_600.0).contains(&lease);
         check("subscription_lease_s", ok, lease, "1..=3600")?;
         let mb = self.max_model_mb.unwrap_or(DEFAULT_MAX_MODEL_MB);

@@ -8,9 +8,9 @@ use std::time::Instant;
 
 use tokio::sync::Notify;
 
-use crate::engine::monitor::{MonitorTap, Snapshot, DEFAULT_MONITOR_HZ};
-use crate::engine::pipeline::{Pipeline, MAX_SOURCES};
-use crate::engine::streams::StreamKey;
+use engine::monitor::{MonitorTap, Snapshot, DEFAULT_MONITOR_HZ};
+use engine::pipeline::MAX_SOURCES;
+use engine::{Needs, Processed, Sink};
 
 /// The latest snapshot of each stream, and who is watching.
 #[derive(Debug, Default)]
@@ -110,18 +110,30 @@ impl Feed {
             epoch: Instant::now(),
         }
     }
+}
 
-    /// After a datagram whose last frame was of stream `key`: nothing but an atomic load
-    /// while no page is open; otherwise the frame is copied when the stream is due.
-    pub fn after_frame(&mut self, pipeline: &Pipeline, key: &StreamKey) {
+impl Sink for Feed {
+    /// Everything the page draws while a page is open; nothing otherwise.
+    fn needs(&self) -> Needs {
+        match self.board.watched() {
+            true => Needs {
+                markers: true,
+                components: true,
+                state: true,
+                ..Needs::NOTHING
+            },
+            false => Needs::NOTHING,
+        }
+    }
+
+    /// Nothing but an atomic load while no page is open; otherwise the frame is copied when
+    /// its stream is due.
+    fn handle_frame(&mut self, frame: &Processed<'_>) {
         if !self.board.watched() {
             return;
         }
-        let Some(stream) = pipeline.stream(key) else {
-            return;
-        };
         let now_us = self.epoch.elapsed().as_micros() as u64;
-        if let Some(snap) = self.tap.handle_stream(now_us, stream) {
+        if let Some(snap) = self.tap.handle_stream(now_us, frame.stream) {
             self.board.publish(snap);
         }
     }

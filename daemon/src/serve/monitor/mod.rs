@@ -3,7 +3,7 @@
 //! WebSocket per page, served by axum on the daemon's tokio runtime.
 //!
 //! - [`Feed`] (processing thread): after each frame, one atomic load while no page is open;
-//!   with a page open, the engine's [`MonitorTap`](crate::engine::monitor::MonitorTap)
+//!   with a page open, the engine's [`MonitorTap`](engine::monitor::MonitorTap)
 //!   decimates each stream to 30 Hz and the snapshot is swapped onto the [`Board`] with a
 //!   `try_lock` (never waiting on the page's side);
 //! - `hub`: wakes on the board, encodes each fresh snapshot once (`wire`) and hands it to every
@@ -35,7 +35,7 @@ use tokio::net::TcpListener;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
-use super::config::ConfigError;
+use super::config_error::ConfigError;
 use super::control::ControlCtx;
 use super::stats::Stats;
 

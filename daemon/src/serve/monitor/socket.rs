@@ -15,9 +15,9 @@ use serde_json::{json, Value};
 
 use super::hub::Joined;
 use super::Monitor;
-use crate::engine::monitor::DEFAULT_MONITOR_HZ;
 use crate::serve::command::Refusal;
 use crate::serve::control::{count_refusal, execute, Answer};
+use engine::monitor::DEFAULT_MONITOR_HZ;
 
 /// A page that takes longer than this to accept one message is disconnected.
 const SEND_TIMEOUT: Duration = Duration::from_secs(5);

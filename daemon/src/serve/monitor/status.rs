@@ -7,8 +7,8 @@ use std::collections::VecDeque;
 use hdrhistogram::Histogram;
 use serde_json::{json, Value};
 
-use crate::engine::StreamStatus;
 use crate::serve::stats::{MonitorCounters, Stats, SubscriberStatus};
+use engine::StreamStatus;
 
 /// Seconds the recent latency window spans.
 pub(crate) const WINDOW_S: usize = 5;
@@ -68,27 +68,27 @@ pub(crate) struct Health {
 impl Health {
     /// Copies the counters out (quick: no percentile is computed under the lock).
     pub(crate) fn of(s: &Stats) -> Health {
-        let c = &s.counters;
+        let (c, i) = (&s.counters, s.input());
         let value = json!({
             "model": s.model,
-            "frames_in": c.frames_in,
+            "frames_in": i.frames_in,
             "frames_out": c.frames_out,
             "drops": {
                 "queue_full": c.dropped_queue_full,
                 "duplicate": c.dropped_duplicate,
                 "stale": c.dropped_stale,
-                "no_layout": c.dropped_no_layout,
+                "no_layout": i.dropped_no_layout,
                 "unmatched": c.dropped_unmatched,
                 "not_allowed": s.dropped_not_allowed,
-                "bad_packets": c.bad_total(),
+                "bad_packets": i.bad_total(),
                 "send_buffer": s.send.dropped_send_buffer,
                 "send_errors": s.send.send_errors,
-                "frame_errors": c.frame_errors,
+                "frame_errors": c.frame_errors + s.send.encode_errors,
             },
             "missing_markers": c.missing_markers,
             "glitches": c.glitches,
             "restarts": c.restarts,
-            "labels_refused": c.labels_refused,
+            "labels_refused": i.labels_refused,
             "control_refused": s.control_refused,
             "streams": s.per_stream.iter().map(stream).collect::<Vec<_>>(),
             "subscribers": s.subscribers.iter().map(subscriber).collect::<Vec<_>>(),

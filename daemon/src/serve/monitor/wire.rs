@@ -20,7 +20,7 @@
 use ica_core::model::IcaModel;
 use serde_json::{json, Value};
 
-use crate::engine::monitor::Snapshot;
+use engine::monitor::Snapshot;
 
 /// The first four bytes of a snapshot message.
 pub(crate) const MAGIC: &[u8; 4] = b"EMF1";
@@ -114,7 +114,7 @@ pub(crate) fn model_json(stream_id: i32, model: &IcaModel, file: Option<&str>) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synthetic::random_space_model;
+    use engine::synthetic::random_space_model;
 
     fn f32_at(b: &[u8], at: usize) -> f32 {
         f32::from_le_bytes(b[at..at + 4].try_into().expect("4 bytes"))

@@ -12,8 +12,8 @@ use std::ops::Range;
 
 use super::sample::narrow;
 use super::spill::f32_values;
-use crate::engine::frame::FramePrep;
 use crate::offline::ModelFrames;
+use engine::frame::FramePrep;
 
 /// Consecutive items whose sizes add up to about `target` (at least one item each). The first
 /// batches are smaller (a quarter, then half the target): the pipelines below work on one

@@ -13,11 +13,11 @@ use rayon::ThreadPool;
 use super::read::{at_rate, batches, for_each_batch};
 use super::sample::{frames_range, Sampler};
 use super::spill::{f32_bytes, Spill};
-use crate::engine::layout::LabelMap;
 use crate::offline::progress::Progress;
 use crate::offline::takes::frames_in_model_order;
 use crate::offline::training::{MissingCounts, PrepOptions};
 use crate::offline::{load_take_with, LoadedTake, ModelFrames};
+use engine::layout::LabelMap;
 
 /// Bytes of take files loaded at once in the first pass.
 const SCAN_BATCH_BYTES: u64 = 16 << 20;

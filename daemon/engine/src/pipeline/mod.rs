@@ -1,0 +1,277 @@
+//! The [`Pipeline`]: the engine's one entry point (the path is drawn in [`crate`]). It owns the
+//! streams and every buffer a frame goes through (sized at construction, and per stream when
+//! the stream is made).
+//!
+//! Call order, on the one thread that owns it:
+//!
+//! 1. [`Pipeline::handle_frame`] per source frame, with the sink every output hangs off: the
+//!    processed frame goes to the sink once (or the frame is dropped and counted);
+//! 2. [`Pipeline::poll_refusal`] after it: a reason the frame's source should hear;
+//! 3. between two frames (a frame boundary, so no frame sees half a change):
+//!    [`Pipeline::handle_edit`], [`Pipeline::check_model`] then [`Pipeline::set_model`];
+//! 4. every [`SWEEP_SECONDS`] on the caller's clock: [`Pipeline::forget_quiet_streams`].
+
+use std::sync::Arc;
+
+use ica_core::model::IcaModel;
+use protocol::{Control, FrameBuf, FrameTime};
+
+use crate::edit_state::{apply_edit, EditRefused, EditState};
+use crate::input::SourceFrame;
+use crate::output::Sink;
+use crate::streams::{Performer, StreamKey, StreamStatus, Streams};
+use crate::Counters;
+
+mod run;
+mod setup;
+
+/// A source's frame refused with a reason its source should hear (an OSC source gets
+/// `/emoshift/error` on the frame socket); the shell tells it, rate-limited.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Refusal {
+    /// The stream refused (its source is `key.source`).
+    pub key: StreamKey,
+    /// Why.
+    pub why: String,
+}
+
+/// A model refused because running streams lack some of its markers.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}", describe_mismatch(streams))]
+pub struct ModelMismatch {
+    /// Each stream it does not fit, with the model's markers the stream's source does not name.
+    pub streams: Vec<(String, Vec<String>)>,
+}
+
+/// `names` as a short list: the first `shown`, then how many more.
+pub fn short_list(names: &[String], shown: usize) -> String {
+    let first: Vec<&str> = names.iter().take(shown).map(String::as_str).collect();
+    match names.len().saturating_sub(first.len()) {
+        0 => first.join(", "),
+        more => format!("{} and {more} more", first.join(", ")),
+    }
+}
+
+fn describe_mismatch(streams: &[(String, Vec<String>)]) -> String {
+    let each: Vec<String> = streams
+        .iter()
+        .map(|(name, missing)| {
+            format!(
+                "stream {name} lacks {} of its markers: {}",
+                missing.len(),
+                short_list(missing, 8)
+            )
+        })
+        .collect();
+    format!(
+        "the model does not fit the running streams, kept the old one: {}",
+        each.join("; ")
+    )
+}
+
+/// Streams at most (bounds memory against spoofed senders).
+pub const MAX_SOURCES: usize = 64;
+/// Sweeps ([`Pipeline::forget_quiet_streams`]) a stream may stay silent through: at the next
+/// it is forgotten, and its slot among [`MAX_SOURCES`] is free again. A stream that comes back
+/// is made again on its next frame, under the same id.
+pub const QUIET_SWEEPS: u64 = 3;
+/// How often the shell sweeps, seconds (for the refusal's words; the shell owns the clock).
+pub const SWEEP_SECONDS: u64 = 10;
+
+/// Pipeline settings.
+#[derive(Debug, Clone)]
+pub struct PipelineConfig {
+    /// Low-pass window of the emotion edit (seconds).
+    pub lowpass_s: f32,
+    /// Largest frame accepted (markers).
+    pub max_markers: usize,
+}
+
+impl Default for PipelineConfig {
+    fn default() -> Self {
+        PipelineConfig {
+            lowpass_s: crate::edit_state::DEFAULT_LOWPASS_S,
+            max_markers: 1_000,
+        }
+    }
+}
+
+/// The processing path. See the module docs for the call order.
+#[derive(Debug)]
+pub struct Pipeline {
+    config: PipelineConfig,
+    model: Arc<IcaModel>,
+    performers: Vec<Performer>,
+    streams: Streams,
+    /// Settings of the default model's streams, copied into new streams.
+    template: EditState,
+    frame_out: FrameBuf,
+    /// The time of the frame being handled.
+    time_in: FrameTime,
+    /// The last refusal the source should hear, taken by the shell after each frame.
+    refusal: Option<Refusal>,
+    /// Sweeps so far.
+    sweeps: u64,
+    /// Counters, read by the caller between frames.
+    pub counters: Counters,
+}
+
+impl Pipeline {
+    /// A pipeline over `model`, with optional named performers.
+    pub fn new(model: Arc<IcaModel>, performers: Vec<Performer>, config: PipelineConfig) -> Self {
+        let template = EditState::for_model(&model, config.lowpass_s);
+        Pipeline {
+            streams: Streams::new(MAX_SOURCES),
+            frame_out: FrameBuf::with_max_markers(config.max_markers),
+            time_in: FrameTime::default(),
+            refusal: None,
+            sweeps: 0,
+            counters: Counters::default(),
+            template,
+            model,
+            performers,
+            config,
+        }
+    }
+
+    /// Takes one source frame through its stream ([`crate::Stream::process`]) and gives the
+    /// processed frame to `sink`, once. A stream is made on its first frame (its model, its
+    /// performer, its label map); a stream whose source relabels it starts over.
+    pub fn handle_frame(&mut self, frame: &SourceFrame<'_>, sink: &mut dyn Sink) {
+        let key = frame.key;
+        if self
+            .streams
+            .get(&key)
+            .is_some_and(|s| !s.has_source_labels(frame.labels))
+        {
+            self.streams.forget(key.source, key.layout_id);
+        }
+        self.time_in = frame.time;
+        let defaults = setup::Defaults {
+            performers: &self.performers,
+            model: &self.model,
+            template: &self.template,
+            lowpass_s: self.config.lowpass_s,
+        };
+        let io = run::Io {
+            frame_out: &mut self.frame_out,
+            time: &self.time_in,
+            sweep: self.sweeps,
+            counters: &mut self.counters,
+        };
+        let unmatched = io.counters.dropped_unmatched;
+        run::frame_step(&mut self.streams, &defaults, frame, io, sink);
+        if self.counters.dropped_unmatched > unmatched {
+            let why = self.why_no_stream(frame.labels);
+            self.refusal = Some(Refusal { key, why });
+        }
+    }
+
+    /// The refusal of the last frame, if it was refused with a reason for its source.
+    pub fn poll_refusal(&mut self) -> Option<Refusal> {
+        self.refusal.take()
+    }
+
+    /// Forgets the streams no frame reached in the last [`QUIET_SWEEPS`] calls (the shell
+    /// calls this every [`SWEEP_SECONDS`]), freeing their slots: a stage whose sources restart
+    /// from new ports (a bridge or Motive restarted) would otherwise fill the [`MAX_SOURCES`]
+    /// slots with dead streams, and the next one would never be taken. Returns them.
+    pub fn forget_quiet_streams(&mut self) -> Vec<StreamKey> {
+        self.sweeps += 1;
+        match self.sweeps.checked_sub(QUIET_SWEEPS) {
+            Some(since) => self.streams.forget_quiet(since),
+            None => Vec::new(),
+        }
+    }
+
+    /// Streams now.
+    pub fn stream_count(&self) -> usize {
+        self.streams.len()
+    }
+
+    /// The stream of `key`, to read between frames.
+    pub fn stream(&self, key: &StreamKey) -> Option<&crate::Stream> {
+        self.streams.get(key)
+    }
+
+    /// Each stream's counters.
+    pub fn stream_status(&self) -> Vec<StreamStatus> {
+        self.streams.status(&self.performers)
+    }
+
+    /// Whether `model` can replace the default model: every stream running on the default
+    /// model must name all of `model`'s markers, or it would be left with markers it never
+    /// sees (or none at all).
+    ///
+    /// # Errors
+    /// The streams it does not fit and the markers each lacks.
+    pub fn check_model(&self, model: &IcaModel) -> Result<(), ModelMismatch> {
+        let mut streams = Vec::new();
+        for (_, stream) in self.streams.iter() {
+            if !Arc::ptr_eq(&stream.model, &self.model) {
+                continue;
+            }
+            let missing = stream.missing_from_source(model.labels());
+            if !missing.is_empty() {
+                streams.push((stream.identity.name.clone(), missing));
+            }
+        }
+        match streams.is_empty() {
+            true => Ok(()),
+            false => Err(ModelMismatch { streams }),
+        }
+    }
+
+    /// Swaps in a new default model at a frame boundary: streams on the default model are
+    /// rebuilt on it, keeping their edit settings; no frame is dropped. Check it with
+    /// [`Pipeline::check_model`] first: a stream it does not fit keeps the old model.
+    pub fn set_model(&mut self, model: Arc<IcaModel>) {
+        let mut template = EditState::for_model(&model, self.config.lowpass_s);
+        template.copy_settings(&self.template);
+        self.template = template;
+        let old = std::mem::replace(&mut self.model, model);
+        for (_, stream) in self.streams.iter_mut() {
+            if !Arc::ptr_eq(&stream.model, &old) {
+                continue;
+            }
+            // A stream whose labels share nothing with the new model keeps the old one.
+            if let Ok(fresh) = stream.rebuilt_on(Arc::clone(&self.model), self.config.lowpass_s) {
+                *stream = fresh;
+            }
+        }
+        self.counters.model_swaps += 1;
+    }
+
+    /// Applies an edit control to the template and every stream.
+    ///
+    /// # Errors
+    /// [`EditRefused`] when the default model cannot take it (component out of range, no
+    /// emotion component, unknown emotion); streams of other models skip what they cannot take.
+    pub fn handle_edit(&mut self, control: &Control) -> Result<(), EditRefused> {
+        let model = Arc::clone(&self.model);
+        apply_edit(&mut self.template, &model, control)?;
+        for (_, stream) in self.streams.iter_mut() {
+            let m = Arc::clone(&stream.model);
+            let _ = apply_edit(&mut stream.edit, &m, control);
+        }
+        Ok(())
+    }
+
+    /// Why a frame made no stream: the stream table is full, or its markers are none of the
+    /// model's.
+    fn why_no_stream(&self, labels: &[String]) -> String {
+        if self.streams.len() >= MAX_SOURCES {
+            return format!("the daemon already runs {MAX_SOURCES} streams");
+        }
+        let model = &self.model.labels()[..self.model.labels().len().min(4)];
+        format!(
+            "none of its {} markers ({}) is a marker of the model, whose markers start {}",
+            labels.len(),
+            short_list(labels, 4),
+            model.join(", ")
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,139 @@
+//! What the OSC output sends about each stream besides its frames: its `/mocap/labels` (model
+//! order, layout id = stream id) and the VMC blend names of its labelled components, made
+//! once per stream and model (a model swap makes them again).
+
+use std::sync::Arc;
+
+use engine::pipeline::MAX_SOURCES;
+use engine::Processed;
+use ica_core::model::IcaModel;
+use protocol::{encode_labels_into, Labels};
+
+/// One stream's labels message and blend names.
+#[derive(Debug)]
+pub struct StreamNames {
+    id: i32,
+    model: Arc<IcaModel>,
+    /// `/mocap/labels` of the stream (empty when a label cannot be sent).
+    pub labels_msg: Vec<u8>,
+    /// VMC blend names of the labelled components (`/VMC/Ext/Blend/Val`).
+    pub vmc: Vec<(String, usize)>,
+}
+
+/// The names of the streams seen lately, at most [`MAX_SOURCES`].
+#[derive(Debug, Default)]
+pub struct Names {
+    streams: Vec<StreamNames>,
+    /// When each was last used (a count of frames), to evict the longest unused.
+    used: Vec<u64>,
+    frames: u64,
+}
+
+impl Names {
+    /// The names of `frame`'s stream, made on its first frame or after a model swap.
+    pub fn of(&mut self, frame: &Processed<'_>) -> &StreamNames {
+        self.frames += 1;
+        let (id, model) = (frame.identity().id, &frame.stream.model);
+        let at = match self.streams.iter().position(|s| s.id == id) {
+            Some(i) if Arc::ptr_eq(&self.streams[i].model, model) => i,
+            Some(i) => {
+                self.streams[i] = StreamNames::new(id, model);
+                i
+            }
+            None if self.streams.len() < MAX_SOURCES => {
+                self.streams.push(StreamNames::new(id, model));
+                self.used.push(0);
+                self.streams.len() - 1
+            }
+            None => {
+                let oldest = (0..self.used.len())
+                    .min_by_key(|&i| self.used[i])
+                    .unwrap_or(0);
+                self.streams[oldest] = StreamNames::new(id, model);
+                oldest
+            }
+        };
+        self.used[at] = self.frames;
+        &self.streams[at]
+    }
+}
+
+impl StreamNames {
+    fn new(id: i32, model: &Arc<IcaModel>) -> StreamNames {
+        let labels = Labels {
+            layout_id: id,
+            names: model.labels().to_vec(),
+        };
+        let mut labels_msg = Vec::new();
+        if encode_labels_into(&labels, &mut labels_msg).is_err() {
+            labels_msg.clear();
+        }
+        StreamNames {
+            id,
+            model: Arc::clone(model),
+            labels_msg,
+            vmc: vmc_names(model),
+        }
+    }
+}
+
+/// Blend names for the components with a known role: `emotion`, `speech1`, `speech2`, ...,
+/// `eyebrows1`, `eyelids1` (a role held by one component has no number). Unknown and other
+/// components are not named.
+pub fn vmc_names(model: &IcaModel) -> Vec<(String, usize)> {
+    use ica_core::model::Role;
+    let name = |role: Role| match role {
+        Role::Emotion => Some("emotion"),
+        Role::Speech => Some("speech"),
+        Role::Eyebrows => Some("eyebrows"),
+        Role::Eyelids => Some("eyelids"),
+        Role::Unknown | Role::Other => None,
+    };
+    let roles = model.roles();
+    let mut out = Vec::new();
+    for (k, &role) in roles.iter().enumerate() {
+        let Some(base) = name(role) else { continue };
+        let same = roles.iter().filter(|&&r| r == role).count();
+        if same == 1 {
+            out.push((base.to_string(), k));
+        } else {
+            let nth = roles[..=k].iter().filter(|&&r| r == role).count();
+            out.push((format!("{base}{nth}"), k));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use ica_core::model::Role;
+
+    use super::*;
+    use engine::synthetic::random_model;
+
+    #[test]
+    fn labelled_components_get_blend_names() {
+        let mut model = random_model(6, 5, 1);
+        for (k, role) in [
+            Role::Emotion,
+            Role::Speech,
+            Role::Other,
+            Role::Speech,
+            Role::Eyelids,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            model.set_role(k, role).expect("in range");
+        }
+        let names = vmc_names(&model);
+        let expected = [
+            ("emotion", 0),
+            ("speech1", 1),
+            ("speech2", 3),
+            ("eyelids", 4),
+        ];
+        let got: Vec<(&str, usize)> = names.iter().map(|(n, k)| (n.as_str(), *k)).collect();
+        assert_eq!(got, expected);
+    }
+}

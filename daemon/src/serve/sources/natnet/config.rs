@@ -1,0 +1,173 @@
+//! The NatNet source's settings: the `natnet*` keys of the config (and their flags), checked
+//! once into a [`NatNetConfig`].
+
+use std::collections::HashMap;
+use std::net::{IpAddr, SocketAddr};
+
+use protocol::natnet::DEFAULT_COMMAND_PORT;
+use protocol::TimecodeRate;
+
+use super::frames::Naming;
+use crate::serve::config_error::ConfigError;
+
+/// The `natnet*` keys as written.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RawNatNet {
+    /// `natnet`: the server's command channel, `IP[:PORT]` (port 1510 by default).
+    pub server: Option<String>,
+    /// `natnet_data`: where frames arrive, `IP:PORT`: a multicast group (joined on the
+    /// interface) or a local unicast address; by default what the server info announces.
+    pub data: Option<String>,
+    /// `natnet_interface`: local IPv4 address multicast is joined on.
+    pub interface: Option<String>,
+    /// `natnet_timecode_rate`: the rate of Motive's timecode (`29.97df`, `30`, `25`...).
+    pub timecode_rate: Option<String>,
+    /// `natnet_names`: `asset:marker` (default), `asset_marker` or `marker`.
+    pub names: Option<String>,
+    /// `[natnet_rename]`: built names to model labels.
+    pub rename: HashMap<String, String>,
+}
+
+/// A checked NatNet source.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NatNetConfig {
+    /// The server's command address.
+    pub server: SocketAddr,
+    /// Where frames arrive, if not where the server info says.
+    pub data: Option<SocketAddr>,
+    /// Interface multicast is joined on (by default loopback for a loopback server, else any).
+    pub interface: Option<std::net::Ipv4Addr>,
+    /// Timecode rate (NatNet does not send it).
+    pub timecode_rate: Option<TimecodeRate>,
+    /// How markers are named.
+    pub naming: Naming,
+}
+
+impl RawNatNet {
+    /// `None` when no server is given (then every other `natnet*` key must be absent too).
+    ///
+    /// # Errors
+    /// The first bad value, named by its key.
+    pub fn validate(self) -> Result<Option<NatNetConfig>, ConfigError> {
+        let Some(server) = self.server else {
+            let stray = self.data.is_some()
+                || self.interface.is_some()
+                || self.timecode_rate.is_some()
+                || self.names.is_some()
+                || !self.rename.is_empty();
+            if stray {
+                return Err(ConfigError::Range {
+                    key: "natnet",
+                    value: "absent".into(),
+                    range: "a server IP[:PORT] when other natnet_* keys are set",
+                });
+            }
+            return Ok(None);
+        };
+        let server = parse_server(&server)?;
+        let data = self
+            .data
+            .map(|d| {
+                d.parse::<SocketAddr>().map_err(|_| ConfigError::Address {
+                    key: "natnet_data",
+                    value: d,
+                })
+            })
+            .transpose()?;
+        let interface = self
+            .interface
+            .map(|i| {
+                i.parse().map_err(|_| ConfigError::Address {
+                    key: "natnet_interface",
+                    value: i,
+                })
+            })
+            .transpose()?;
+        let timecode_rate = self
+            .timecode_rate
+            .map(|r| {
+                TimecodeRate::parse(&r).map_err(|e| ConfigError::Range {
+                    key: "natnet_timecode_rate",
+                    value: format!("{r:?} ({e})"),
+                    range: "24, 25, 29.97df, 30, 59.94df, 60 or N/D[df]",
+                })
+            })
+            .transpose()?;
+        let separator = match self.names.as_deref().unwrap_or("asset:marker") {
+            "asset:marker" => Some(":".to_string()),
+            "asset_marker" => Some("_".to_string()),
+            "marker" => None,
+            other => {
+                return Err(ConfigError::Range {
+                    key: "natnet_names",
+                    value: format!("{other:?}"),
+                    range: "asset:marker, asset_marker or marker",
+                })
+            }
+        };
+        Ok(Some(NatNetConfig {
+            server,
+            data,
+            interface,
+            timecode_rate,
+            naming: Naming {
+                separator,
+                rename: self.rename,
+            },
+        }))
+    }
+}
+
+/// `IP` or `IP:PORT` (IPv6 as `[::1]:PORT`).
+fn parse_server(text: &str) -> Result<SocketAddr, ConfigError> {
+    if let Ok(a) = text.parse::<SocketAddr>() {
+        return Ok(a);
+    }
+    text.parse::<IpAddr>()
+        .map(|ip| SocketAddr::new(ip, DEFAULT_COMMAND_PORT))
+        .map_err(|_| ConfigError::Address {
+            key: "natnet",
+            value: text.to_string(),
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn servers_default_to_the_command_port_and_bad_keys_are_named() {
+        let raw = RawNatNet {
+            server: Some("10.0.0.5".into()),
+            data: Some("239.255.42.99:1511".into()),
+            timecode_rate: Some("29.97df".into()),
+            names: Some("asset_marker".into()),
+            ..RawNatNet::default()
+        };
+        let c = raw.validate().expect("valid").expect("a server");
+        assert_eq!(c.server, "10.0.0.5:1510".parse().expect("addr"));
+        assert_eq!(c.timecode_rate, Some(TimecodeRate::DF_29_97));
+        assert_eq!(c.naming.separator.as_deref(), Some("_"));
+        let bad = |raw: RawNatNet| raw.validate().expect_err("bad").to_string();
+        let with = |f: fn(&mut RawNatNet)| {
+            let mut r = RawNatNet {
+                server: Some("127.0.0.1".into()),
+                ..RawNatNet::default()
+            };
+            f(&mut r);
+            r
+        };
+        assert!(
+            bad(with(|r| r.timecode_rate = Some("25df".into()))).contains("natnet_timecode_rate")
+        );
+        assert!(bad(with(|r| r.names = Some("x".into()))).contains("natnet_names"));
+        assert!(bad(with(|r| r.data = Some("here".into()))).contains("natnet_data"));
+        assert!(bad(with(|r| r.server = Some("motive".into()))).contains("natnet"));
+        let stray = RawNatNet {
+            data: Some("239.255.42.99:1511".into()),
+            ..RawNatNet::default()
+        };
+        assert!(bad(stray).contains("natnet"));
+        assert_eq!(RawNatNet::default().validate(), Ok(None));
+    }
+}
