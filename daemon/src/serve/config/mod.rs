@@ -15,7 +15,7 @@ pub use super::config_error::ConfigError;
 
 mod values;
 pub use values::parse_send;
-use values::{addr, check, performer, secret};
+use values::{addr, check, check_token, performer, secret};
 
 pub use engine::PerformerConfig;
 
@@ -236,7 +236,7 @@ impl RawConfig {
                 .monitor
                 .map(|m| addr("monitor", Some(m), ""))
                 .transpose()?,
-            monitor_token: super::monitor::check_token(self.monitor_token)?,
+            monitor_token: check_token(self.monitor_token)?,
         })
     }
 

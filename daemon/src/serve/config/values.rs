@@ -98,3 +98,26 @@ pub fn parse_send(text: &str) -> Result<(SocketAddr, Profile), ConfigError> {
     })?;
     Ok((addr, profile))
 }
+
+/// Token length bounds, bytes.
+const TOKEN_BYTES: std::ops::RangeInclusive<usize> = 16..=256;
+
+/// Checks a configured token: 16 to 256 URL-safe characters (letters, digits, `-._~`), so it
+/// goes into `?token=` and a cookie as it is.
+///
+/// # Errors
+/// [`ConfigError::Range`] naming `monitor_token`.
+pub(super) fn check_token(token: Option<String>) -> Result<Option<String>, ConfigError> {
+    let Some(t) = token else { return Ok(None) };
+    let safe = t
+        .bytes()
+        .all(|b| b.is_ascii_alphanumeric() || b"-._~".contains(&b));
+    match safe && TOKEN_BYTES.contains(&t.len()) {
+        true => Ok(Some(t)),
+        false => Err(ConfigError::Range {
+            key: "monitor_token",
+            value: format!("of {} bytes", t.len()),
+            range: "16 to 256 letters, digits or -._~",
+        }),
+    }
+}

@@ -35,7 +35,6 @@ use tokio::net::TcpListener;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
-use super::config_error::ConfigError;
 use super::control::ControlCtx;
 use super::stats::Stats;
 
@@ -43,29 +42,6 @@ use super::stats::Stats;
 pub const DEFAULT_MONITOR: &str = "127.0.0.1:9080";
 /// Pages open at once, at most; more are refused (503) and counted.
 pub const MAX_VIEWERS: usize = 8;
-/// Token length bounds, bytes.
-const TOKEN_BYTES: std::ops::RangeInclusive<usize> = 16..=256;
-
-/// Checks a configured token: 16 to 256 URL-safe characters (letters, digits, `-._~`), so it
-/// goes into `?token=` and a cookie as it is.
-///
-/// # Errors
-/// [`ConfigError::Range`] naming `monitor_token`.
-pub fn check_token(token: Option<String>) -> Result<Option<String>, ConfigError> {
-    let Some(t) = token else { return Ok(None) };
-    let safe = t
-        .bytes()
-        .all(|b| b.is_ascii_alphanumeric() || b"-._~".contains(&b));
-    match safe && TOKEN_BYTES.contains(&t.len()) {
-        true => Ok(Some(t)),
-        false => Err(ConfigError::Range {
-            key: "monitor_token",
-            value: format!("of {} bytes", t.len()),
-            range: "16 to 256 letters, digits or -._~",
-        }),
-    }
-}
-
 /// Binds the monitor's listener (so a bad address fails at start, and tests learn the port).
 ///
 /// # Errors
