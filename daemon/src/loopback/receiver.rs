@@ -194,36 +194,43 @@ where
                 Some(Err(_)) => continue,
             },
         };
-        let at = Instant::now();
         wait = quiet;
-        let Ok(msgs) = messages(&buf[..n], &Limits::default()) else {
+        let Some(got) = decode(&buf[..n], Instant::now(), &mut frame, &mut u) else {
             continue;
-        };
-        let (mut header, mut state, mut components) = (None, None, None);
-        let (mut stream, mut labels, mut time) = (None, None, None);
-        for m in msgs {
-            match Address::parse(m.address) {
-                Some(Address::Stream) => stream = decode_stream(m.bytes).ok(),
-                Some(Address::Labels) => labels = decode_labels(m.bytes).ok(),
-                Some(Address::Frame) => header = decode_frame_into(m.bytes, &mut frame).ok(),
-                Some(Address::State) => state = decode_state(m.bytes).ok(),
-                Some(Address::Timecode) => time = protocol::decode_timecode(m.bytes).ok(),
-                Some(Address::Components) => {
-                    components = decode_components_into(m.bytes, &mut u).ok();
-                }
-                _ => {}
-            }
-        }
-        let got = Received {
-            at,
-            stream,
-            labels,
-            frame: header.map(|h| (h, &frame)),
-            state,
-            components: components.map(|k| &u[..k]),
-            time,
         };
         sink(&mut kept, &got);
     }
     kept
+}
+
+/// What one datagram carried; `None` when it does not scan.
+fn decode<'a>(
+    datagram: &'a [u8],
+    at: Instant,
+    frame: &'a mut FrameBuf,
+    u: &'a mut [f32],
+) -> Option<Received<'a>> {
+    let msgs = messages(datagram, &Limits::default()).ok()?;
+    let (mut header, mut state, mut components) = (None, None, None);
+    let (mut stream, mut labels, mut time) = (None, None, None);
+    for m in msgs {
+        match Address::parse(m.address) {
+            Some(Address::Stream) => stream = decode_stream(m.bytes).ok(),
+            Some(Address::Labels) => labels = decode_labels(m.bytes).ok(),
+            Some(Address::Frame) => header = decode_frame_into(m.bytes, frame).ok(),
+            Some(Address::State) => state = decode_state(m.bytes).ok(),
+            Some(Address::Timecode) => time = protocol::decode_timecode(m.bytes).ok(),
+            Some(Address::Components) => components = decode_components_into(m.bytes, u).ok(),
+            _ => {}
+        }
+    }
+    Some(Received {
+        at,
+        stream,
+        labels,
+        frame: header.map(|h| (h, &*frame)),
+        state,
+        components: components.map(|k| &u[..k]),
+        time,
+    })
 }

@@ -145,13 +145,8 @@ impl Bound {
     pub async fn run(self, shutdown: CancellationToken) -> Result<()> {
         let tracker = TaskTracker::new();
         let osc = Arc::new(InputCounters::named("osc"));
-        let mut stats = Stats::new();
-        stats.model = self.config.model.display().to_string();
-        stats.inputs.push(Arc::clone(&osc));
-        if let Some((_, counters)) = &self.natnet {
-            stats.inputs.push(Arc::clone(counters));
-        }
-        let stats = Arc::new(Mutex::new(stats));
+        let natnet_counters = self.natnet.as_ref().map(|n| Arc::clone(&n.1));
+        let stats = new_stats(&self.config, [Some(Arc::clone(&osc)), natnet_counters]);
         let shared = Shared {
             stats: Arc::clone(&stats),
             queue_dropped: Arc::new(AtomicU64::new(0)),
@@ -173,6 +168,7 @@ impl Bound {
             tracker: tracker.clone(),
             guard: Arc::new(Guard::new(&self.config)),
         };
+        let every = self.config.stats_interval;
         let board = Arc::new(Board::new());
         if let Some(listener) = self.monitor {
             let token = self.config.monitor_token.clone();
@@ -188,20 +184,13 @@ impl Bound {
             max_markers,
         };
         let feed = self.config.monitor.map(|_| Feed::new(board));
-        let (every, poll_window) = (self.config.stats_interval, self.config.poll_window);
         let pipeline = processing_pipeline(self.model, self.performers, &self.config);
         let outputs = outputs(&self.config, feed)?;
-        let processing = Processing::new((pipeline, outputs), poll_window, (ends, cmd_rx), shared);
+        let window = self.config.poll_window;
+        let processing = Processing::new((pipeline, outputs), window, (ends, cmd_rx), shared);
         let processing = tracker.spawn_blocking(move || processing.run());
-        if let Some((link, _)) = self.natnet {
-            tracker.spawn(natnet(
-                link,
-                queue.clone(),
-                Arc::clone(&stats),
-                shutdown.clone(),
-            ));
-        }
-        tracker.spawn(receive(source, queue, shutdown.clone()));
+        let link = self.natnet.map(|n| n.0);
+        spawn_sources((source, link), (queue, &stats), &tracker, &shutdown);
         tracker.spawn(control::run(ctx.clone(), shutdown.clone()));
         tracker.spawn(control::reload_on_sighup(ctx, shutdown.clone()));
         tracker.spawn(log_stats(stats, every, shutdown.clone()));
@@ -210,6 +199,14 @@ impl Bound {
         tracker.wait().await;
         result.context("processing thread panicked")
     }
+}
+
+/// The shared stats, with the model's file and each source's counters.
+fn new_stats(config: &Config, inputs: [Option<Arc<InputCounters>>; 2]) -> Arc<Mutex<Stats>> {
+    let mut stats = Stats::new();
+    stats.model = config.model.display().to_string();
+    stats.inputs.extend(inputs.into_iter().flatten());
+    Arc::new(Mutex::new(stats))
 }
 
 /// The engine over the models.
@@ -244,6 +241,21 @@ fn outputs(config: &Config, feed: Option<Feed>) -> Result<Outputs> {
         recorder: Recorder::new(),
         others,
     })
+}
+
+/// Every source's task, its frames into `queue`: the OSC frame socket, the NatNet link when
+/// configured (its status into `stats`). A new source is one more task here.
+fn spawn_sources(
+    (osc, natnet_link): (OscSource, Option<Link>),
+    (queue, stats): (Queue, &Arc<Mutex<Stats>>),
+    tracker: &TaskTracker,
+    shutdown: &CancellationToken,
+) {
+    if let Some(link) = natnet_link {
+        let stats = Arc::clone(stats);
+        tracker.spawn(natnet(link, queue.clone(), stats, shutdown.clone()));
+    }
+    tracker.spawn(receive(osc, queue, shutdown.clone()));
 }
 
 /// The OSC frame socket's task, its frames into the queue.

@@ -137,11 +137,10 @@ impl Stats {
         latency::record(h, us);
     }
 
-    /// `(name, value)` pairs in the order `/status/confirm` carries them: the counters, each
-    /// stream (`stream/<id>/...`), each subscriber (`subscriber/<n>/...`), the latencies.
-    pub fn pairs(&self) -> Vec<(String, StatusValue)> {
-        let (c, i) = (&self.counters, self.input());
-        let mut out: Vec<(String, StatusValue)> = [
+    /// The counters as `(name, value)` pairs, `i` being the sources' counters summed.
+    fn counter_pairs(&self, i: &InputTotals) -> Vec<(String, StatusValue)> {
+        let c = &self.counters;
+        [
             ("frames_in", i.frames_in),
             ("frames_out", c.frames_out),
             ("frames_dropped", c.dropped_queue_full),
@@ -175,7 +174,14 @@ impl Stats {
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), int(v)))
-        .collect();
+        .collect()
+    }
+
+    /// `(name, value)` pairs in the order `/status/confirm` carries them: the counters, each
+    /// stream (`stream/<id>/...`), each subscriber (`subscriber/<n>/...`), the latencies.
+    pub fn pairs(&self) -> Vec<(String, StatusValue)> {
+        let i = self.input();
+        let mut out = self.counter_pairs(&i);
         for kind in DecodeErrorKind::ALL {
             out.push((format!("bad_{}", kind.as_str()), int(i.bad[kind.index()])));
         }

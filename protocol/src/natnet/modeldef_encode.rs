@@ -37,6 +37,13 @@ pub fn encode_model_defs_into(defs: &ModelDefs, version: NatNetVersion, out: &mu
         + defs.cameras.len()
         + assets;
     put_count(out, n)?;
+    put_bodies(out, v, defs)?;
+    put_devices(out, v, defs, assets)?;
+    finish_packet(out)
+}
+
+/// The markersets, rigid bodies and skeletons, each described.
+fn put_bodies(out: &mut Vec<u8>, v: NatNetVersion, defs: &ModelDefs) -> Enc {
     for m in &defs.markersets {
         described(out, v, 0, |out| {
             put_cstr(out, &m.name)?;
@@ -54,6 +61,11 @@ pub fn encode_model_defs_into(defs: &ModelDefs, version: NatNetVersion, out: &mu
             s.bones.iter().try_for_each(|b| put_rigid_body(out, v, b))
         })?;
     }
+    Ok(())
+}
+
+/// The force plates, devices, cameras and the first `assets` assets, each described.
+fn put_devices(out: &mut Vec<u8>, v: NatNetVersion, defs: &ModelDefs, assets: usize) -> Enc {
     for p in &defs.force_plates {
         described(out, v, 3, |out| put_force_plate(out, p))?;
     }
@@ -78,7 +90,7 @@ pub fn encode_model_defs_into(defs: &ModelDefs, version: NatNetVersion, out: &mu
     for a in defs.assets.iter().take(assets) {
         described(out, v, 6, |out| put_asset(out, v, a))?;
     }
-    finish_packet(out)
+    Ok(())
 }
 
 /// Type, then (4.1+) the byte size of the description, then the description.

@@ -58,52 +58,96 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
         .enable_all()
         .build()
         .context("starting the tokio runtime")?;
+    let r = runtime.block_on(measure(&model, args))?;
+    let k = args.clients;
+    print_paced(args, &r)?;
+    for (nn, how) in r.over_natnet.iter().zip(["multicast", "unicast"]) {
+        if let Some(nn) = nn {
+            print_natnet(nn, how, (&r.daemon, &r.relay), k)?;
+        }
+    }
+    if let Some(watched) = &r.watched {
+        print_watched(&r.daemon, watched, k)?;
+    }
+    print_max_rate(&r.max)?;
+    let (per_frame_us, fps) = processing_rate(&model)?;
+    crate::out!(
+        "processing: {per_frame_us:.2} µs/frame median over batches, {fps:.0} frames/s on one thread"
+    );
+    Ok(())
+}
+
+/// What the timed runs measured.
+struct Measured {
+    /// The daemon, paced, every round.
+    daemon: Run,
+    /// The plain relay, paced, every round.
+    relay: harness::Seen,
+    /// The daemon with the monitor page open, every round.
+    watched: Option<Run>,
+    /// The daemon fed over NatNet, multicast and unicast, every round.
+    over_natnet: [Option<Run>; 2],
+    /// The daemon at the maximum rate.
+    max: Run,
+}
+
+/// The paced rounds (daemon and relay alternating, with the NatNet and monitor variants when
+/// asked), then the maximum rate.
+async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
     let rounds = (args.seconds / ROUND.as_secs_f64()).ceil().max(1.0) as u32;
     let per_round = Duration::from_secs_f64(args.seconds) / rounds;
-    let (n, k) = (args.performers, args.clients);
+    let (n, k, w) = (args.performers, args.clients, args.poll_window_us);
     let monitor = args.monitor.as_deref();
-    let (daemon, watched, relay, max, over_natnet) = runtime.block_on(async {
-        let w = args.poll_window_us;
-        let mut daemon = through_daemon(&model, (n, k), 120.0, per_round, w, None).await?;
-        let mut relay = through_relay(&model, n, k, per_round).await?;
-        let mut watched: Option<Run> = None;
-        let mut over_natnet: [Option<Run>; 2] = [None, None];
-        for round in 0..rounds {
-            for (multicast, all) in [true, false].into_iter().zip(over_natnet.iter_mut()) {
-                if !args.natnet {
-                    break;
-                }
-                let r =
-                    natnet::through_daemon_natnet(&model, (n, k), per_round, w, multicast).await?;
-                match all.as_mut() {
-                    None => *all = Some(r),
-                    Some(all) => Run::add(all, r),
-                }
+    let mut daemon = through_daemon(model, (n, k), 120.0, per_round, w, None).await?;
+    let mut relay = through_relay(model, n, k, per_round).await?;
+    let mut watched: Option<Run> = None;
+    let mut over_natnet: [Option<Run>; 2] = [None, None];
+    for round in 0..rounds {
+        for (multicast, all) in [true, false].into_iter().zip(over_natnet.iter_mut()) {
+            if !args.natnet {
+                break;
             }
-            if monitor.is_some() {
-                let run = through_daemon(&model, (n, k), 120.0, per_round, w, monitor).await?;
-                match watched.as_mut() {
-                    None => watched = Some(run),
-                    Some(all) => all.add(run),
-                }
-            }
-            if round + 1 < rounds {
-                daemon.add(through_daemon(&model, (n, k), 120.0, per_round, w, None).await?);
-                relay.add(&through_relay(&model, n, k, per_round).await?);
+            let r = natnet::through_daemon_natnet(model, (n, k), per_round, w, multicast).await?;
+            match all.as_mut() {
+                None => *all = Some(r),
+                Some(all) => Run::add(all, r),
             }
         }
-        let one = Duration::from_secs(1);
-        let max = through_daemon(&model, (1, 1), MAX_RATE_HZ, one, w, None).await?;
-        anyhow::Ok((daemon, watched, relay, max, over_natnet))
-    })?;
-    let sent = daemon.sent * k as u64;
+        if monitor.is_some() {
+            let run = through_daemon(model, (n, k), 120.0, per_round, w, monitor).await?;
+            match watched.as_mut() {
+                None => watched = Some(run),
+                Some(all) => all.add(run),
+            }
+        }
+        if round + 1 < rounds {
+            daemon.add(through_daemon(model, (n, k), 120.0, per_round, w, None).await?);
+            relay.add(&through_relay(model, n, k, per_round).await?);
+        }
+    }
+    let one = Duration::from_secs(1);
+    let max = through_daemon(model, (1, 1), MAX_RATE_HZ, one, w, None).await?;
+    Ok(Measured {
+        daemon,
+        relay,
+        watched,
+        over_natnet,
+        max,
+    })
+}
+
+/// The paced rounds: what came through, the daemon's own stages, and its added latency
+/// against the relay's.
+fn print_paced(args: &BenchArgs, r: &Measured) -> Result<()> {
+    let (daemon, relay) = (&r.daemon, &r.relay);
+    let sent = daemon.sent * args.clients as u64;
     crate::out!(
         "paced: {} performers x 120 Hz, {} clients, {} s, {MARKERS} markers, m = {COMPONENTS}",
         args.performers,
         args.clients,
         args.seconds
     );
-    for (name, s) in [("daemon", &daemon.seen), ("relay", &relay)] {
+    for (name, s) in [("daemon", &daemon.seen), ("relay", relay)] {
         crate::out!("  {name}: {} of ~{sent} datagrams received", s.received);
     }
     crate::out!(
@@ -127,19 +171,6 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
             d as f64 / r.max(1) as f64
         );
     }
-    for (nn, how) in over_natnet.iter().zip(["multicast", "unicast"]) {
-        if let Some(nn) = nn {
-            print_natnet(nn, how, (&daemon, &relay), k)?;
-        }
-    }
-    if let Some(watched) = &watched {
-        print_watched(&daemon, watched, k)?;
-    }
-    print_max_rate(&max)?;
-    let (per_frame_us, fps) = processing_rate(&model)?;
-    crate::out!(
-        "processing: {per_frame_us:.2} µs/frame median over batches, {fps:.0} frames/s on one thread"
-    );
     Ok(())
 }
 

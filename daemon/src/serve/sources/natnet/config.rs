@@ -65,46 +65,13 @@ impl RawNatNet {
             return Ok(None);
         };
         let server = parse_server(&server)?;
-        let data = self
-            .data
-            .map(|d| {
-                d.parse::<SocketAddr>().map_err(|_| ConfigError::Address {
-                    key: "natnet_data",
-                    value: d,
-                })
-            })
-            .transpose()?;
+        let data = self.data.map(|d| parse_key("natnet_data", d)).transpose()?;
         let interface = self
             .interface
-            .map(|i| {
-                i.parse().map_err(|_| ConfigError::Address {
-                    key: "natnet_interface",
-                    value: i,
-                })
-            })
+            .map(|i| parse_key("natnet_interface", i))
             .transpose()?;
-        let timecode_rate = self
-            .timecode_rate
-            .map(|r| {
-                TimecodeRate::parse(&r).map_err(|e| ConfigError::Range {
-                    key: "natnet_timecode_rate",
-                    value: format!("{r:?} ({e})"),
-                    range: "24, 25, 29.97df, 30, 59.94df, 60 or N/D[df]",
-                })
-            })
-            .transpose()?;
-        let separator = match self.names.as_deref().unwrap_or("asset:marker") {
-            "asset:marker" => Some(":".to_string()),
-            "asset_marker" => Some("_".to_string()),
-            "marker" => None,
-            other => {
-                return Err(ConfigError::Range {
-                    key: "natnet_names",
-                    value: format!("{other:?}"),
-                    range: "asset:marker, asset_marker or marker",
-                })
-            }
-        };
+        let timecode_rate = self.timecode_rate.map(parse_rate).transpose()?;
+        let separator = parse_names(self.names.as_deref().unwrap_or("asset:marker"))?;
         Ok(Some(NatNetConfig {
             server,
             data,
@@ -115,6 +82,36 @@ impl RawNatNet {
                 rename: self.rename,
             },
         }))
+    }
+}
+
+/// An address key's value.
+fn parse_key<T: std::str::FromStr>(key: &'static str, value: String) -> Result<T, ConfigError> {
+    value
+        .parse()
+        .map_err(|_| ConfigError::Address { key, value })
+}
+
+/// `natnet_timecode_rate`.
+fn parse_rate(r: String) -> Result<TimecodeRate, ConfigError> {
+    TimecodeRate::parse(&r).map_err(|e| ConfigError::Range {
+        key: "natnet_timecode_rate",
+        value: format!("{r:?} ({e})"),
+        range: "24, 25, 29.97df, 30, 59.94df, 60 or N/D[df]",
+    })
+}
+
+/// `natnet_names`: the separator between asset and marker names (`None`: bare markers).
+fn parse_names(names: &str) -> Result<Option<String>, ConfigError> {
+    match names {
+        "asset:marker" => Ok(Some(":".to_string())),
+        "asset_marker" => Ok(Some("_".to_string())),
+        "marker" => Ok(None),
+        other => Err(ConfigError::Range {
+            key: "natnet_names",
+            value: format!("{other:?}"),
+            range: "asset:marker, asset_marker or marker",
+        }),
     }
 }
 
