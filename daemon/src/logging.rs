@@ -29,14 +29,4 @@ fn colour(terminal: bool, no_color: Option<std::ffi::OsString>) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::colour;
-
-    #[test]
-    fn colour_only_on_a_terminal_without_no_color() {
-        assert!(colour(true, None));
-        assert!(!colour(false, None));
-        assert!(!colour(true, Some("1".into())));
-        assert!(colour(true, Some("".into())));
-    }
-}
+mod tests;

@@ -302,5 +302,4 @@ impl<'a> Iterator for Messages<'a> {
 }
 
 #[cfg(test)]
-#[path = "scan_tests.rs"]
 mod tests;
