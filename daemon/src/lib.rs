@@ -15,20 +15,21 @@
 //!          └────┬─────┘ └────┬─────┘       └────┬─────┘
 //!               │            │                  │
 //!               └────────────┴──────▶ ┌─────────▼──┐
-//!                                     │   engine   │  sans-IO: datagram + now → datagrams
-//!                                     └────────────┘
+//!                                     │   engine   │  its own package: sans-IO, the
+//!                                     └────────────┘  compiler keeps it so
 //! ```
 //!
-//! Arrows point one way: nothing below knows what is above it.
+//! Arrows point one way: nothing below knows what is above it (`scripts/check-modules`).
+//! `docs/architecture.md` walks the frame path and the training path function by function.
 //!
-//! - [`engine`]: everything that turns a datagram into output datagrams and counters, without
-//!   tokio, sockets, clock or files (CI checks it). Its module docs walk a frame's path from
-//!   socket to socket.
+//! - [`engine`] (the `engine` package under `daemon/engine`): a source's frame in, the
+//!   edited frame to every sink, without tokio, sockets, clock or files.
 //! - [`offline`]: takes and models on disk, training preparation ([`offline::training`]),
 //!   analysis ([`offline::analysis`]) and edit planning ([`offline::edit`]), as functions over
 //!   takes and models. Numerics live in `ica-core`.
-//! - [`serve`]: the tokio runtime, the sockets, the control task, the processing thread, the
-//!   sender and the recordings, around one engine [`engine::Pipeline`].
+//! - [`serve`]: the live service around one [`engine::Pipeline`]: the sources
+//!   ([`serve::sources`]), the processing thread, the sinks ([`serve::sinks`]), control, the
+//!   monitor page; and `record`'s capture.
 //! - [`loopback`]: one in-process harness (daemon, paced source, receiver, control client,
 //!   synthetic models) for the demo, `emoshift bench` and the end-to-end tests.
 //! - [`commands`]: one small module per subcommand; [`cli`] is their arguments.

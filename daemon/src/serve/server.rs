@@ -273,7 +273,7 @@ async fn natnet(link: Link, queue: Queue, stats: Arc<Mutex<Stats>>, shutdown: Ca
     };
     let mut on_status = |status: &NatNetStatus| {
         if let Ok(mut s) = stats.lock() {
-            s.natnet = Some(status.clone());
+            s.set_source_status("natnet", status.pairs());
         }
     };
     if let Err(e) = link.run(shutdown, &mut sink, &mut on_status).await {

@@ -10,7 +10,6 @@ use protocol::{DecodeErrorKind, Profile, StatusValue};
 
 use super::latency;
 use super::sinks::osc::SendCounters;
-use super::sources::natnet::NatNetStatus;
 use super::sources::{InputCounters, InputTotals};
 
 /// One subscriber as `/status` lists it.
@@ -63,8 +62,8 @@ pub struct Stats {
     pub control_refused: u64,
     /// Frames from sources outside `frames_allow`.
     pub dropped_not_allowed: u64,
-    /// The NatNet source, when one is configured.
-    pub natnet: Option<NatNetStatus>,
+    /// Each source's own status pairs (`natnet/...`), by source, as the source last told.
+    pub sources: Vec<(&'static str, Vec<(String, StatusValue)>)>,
     /// Per stream id: end-to-end latency from the source's capture time (NatNet: camera
     /// mid-exposure, through the echo's clock offset; OSC: a UTC capture time), µs.
     pub stream_latency_us: Vec<(i32, Histogram<u64>)>,
@@ -99,6 +98,14 @@ impl Stats {
         latency::histogram()
     }
 
+    /// Sets what source `name` tells of itself in `/status`.
+    pub fn set_source_status(&mut self, name: &'static str, pairs: Vec<(String, StatusValue)>) {
+        match self.sources.iter_mut().find(|(n, _)| *n == name) {
+            Some(slot) => slot.1 = pairs,
+            None => self.sources.push((name, pairs)),
+        }
+    }
+
     /// Every source's counters, summed.
     pub fn input(&self) -> InputTotals {
         let mut total = InputTotals::default();
@@ -125,7 +132,7 @@ impl Stats {
             model: String::new(),
             control_refused: 0,
             dropped_not_allowed: 0,
-            natnet: None,
+            sources: Vec::new(),
             stream_latency_us: Vec::new(),
             recording: None,
             monitor: MonitorCounters::default(),
@@ -205,8 +212,8 @@ impl Stats {
         for (n, sub) in self.subscribers.iter().enumerate() {
             subscriber_pairs(n, sub, &mut out);
         }
-        if let Some(n) = &self.natnet {
-            out.extend(n.pairs());
+        for (_, pairs) in &self.sources {
+            out.extend(pairs.iter().cloned());
         }
         for (name, h) in [("processed", &self.processed_us), ("sent", &self.sent_us)] {
             for (q, label) in [(0.5, "p50"), (0.99, "p99"), (0.999, "p999")] {
