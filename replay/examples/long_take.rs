@@ -7,7 +7,8 @@
 
 use std::path::{Path, PathBuf};
 
-use replay::blocks::{open_blocks, TakeWriter};
+use replay::blocks::open_blocks;
+use replay::TakeWriter;
 
 const BLOCK_FRAMES: usize = 4096;
 

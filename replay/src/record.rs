@@ -42,6 +42,7 @@ use std::path::{Path, PathBuf};
 use crate::c3d::write::{self as c3d, FrameRange, Meta};
 use crate::c3d::C3dLimitError;
 use crate::error::{TakeError, WriteError};
+pub use crate::take::RecordTime;
 use crate::trc::text::{check_labels, push_sample};
 use crate::{Format, Take};
 
@@ -49,16 +50,6 @@ use crate::{Format, Take};
 mod trc_header;
 use trc_header::{trc_header, COUNT_WIDTH, RATE_WIDTH};
 
-/// What a live recording knows besides labels, rate and first frame (issue 16).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct RecordTime {
-    /// The first frame's SMPTE timecode: in TRC's header (`Timecode`) and C3D's TIMECODE
-    /// group; with it a CSV recording has a `timecode` column, one per frame.
-    pub timecode: Option<protocol::Smpte>,
-    /// The rate measured from the source (C3D `TRIAL:CAMERA_RATE`, TRC `CameraRate`); may
-    /// also be set before finishing ([`Recorder::set_camera_rate`]).
-    pub camera_rate_hz: Option<f64>,
-}
 /// Write buffer: a few frames of a large layout, so the kernel sees few, large writes.
 const BUFFER_BYTES: usize = 64 * 1024;
 

@@ -1,6 +1,6 @@
 //! The in-memory take: what every reader produces and every writer consumes.
 
-use crate::error::TakeError;
+use crate::error::{ReadError, TakeError};
 
 /// Largest coordinate of a present sample, mm (10 km): no capture volume comes near it, so a
 /// value past it is corrupt data, not a position ([`Take::validate`]).
@@ -222,6 +222,54 @@ impl Take {
                 });
             }
         }
+        Ok(())
+    }
+}
+
+/// What a live recording knows besides labels, rate and first frame (issue 16).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RecordTime {
+    /// The first frame's SMPTE timecode: in TRC's header (`Timecode`) and C3D's TIMECODE
+    /// group; with it a CSV recording has a `timecode` column, one per frame.
+    pub timecode: Option<protocol::Smpte>,
+    /// The rate measured from the source (C3D `TRIAL:CAMERA_RATE`, TRC `CameraRate`); may
+    /// also be set before finishing ([`crate::record::Recorder::set_camera_rate`]).
+    pub camera_rate_hz: Option<f64>,
+}
+
+/// What a take file says before its frames.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TakeHeader {
+    /// Marker labels, in file order.
+    pub labels: Vec<String>,
+    /// Frame rate; `None` for a CSV file without `rate_hz`, whose rate is derived from its
+    /// time column once every row is read.
+    pub rate_hz: Option<f64>,
+    /// Number of the first frame (1 for a file with no frames).
+    pub first_frame: i64,
+    /// Frames the file declares (C3D, TRC); `None` where the format does not say (CSV).
+    pub frames: Option<usize>,
+    /// Units the file declared (values are read in millimetres).
+    pub source_units: Units,
+}
+
+impl TakeHeader {
+    /// A take with no frames and this header's labels, rate (1 Hz when not yet known), first
+    /// frame and units: the block buffer to pass to [`crate::blocks::BlockReader::read_block`].
+    pub fn empty_take(&self) -> Take {
+        let mut take = Take::new(
+            self.labels.clone(),
+            self.rate_hz.unwrap_or(1.0),
+            self.first_frame,
+        );
+        take.source_units = self.source_units;
+        take
+    }
+
+    /// Checks the header against the take invariants that do not depend on frames (labels,
+    /// rate), so a block reader refuses a bad file before its first block.
+    pub(crate) fn validate(&self) -> Result<(), ReadError> {
+        self.empty_take().validate()?;
         Ok(())
     }
 }

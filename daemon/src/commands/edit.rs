@@ -1,5 +1,5 @@
 //! `emoshift edit`: component-space edits of a take ([`crate::offline::edit`]), streamed from
-//! file to output in blocks ([`crate::offline::streamed::edit_file`]) except Copy & Replace and
+//! file to output in blocks ([`crate::offline::edit::edit_file`]) except Copy & Replace and
 //! Copy & Add, which align another take to the whole of this one and hold both in memory.
 
 use anyhow::{Context, Result};
@@ -42,7 +42,7 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
         (out.n_frames(), notices)
     } else {
         let mut progress = super::progress::for_stderr("edit");
-        let done = offline::streamed::edit_file(
+        let done = offline::edit::edit_file(
             (&args.model, &model),
             (&args.file, offline::takes::input_limit()),
             &request,

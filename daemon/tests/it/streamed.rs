@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::common::{ok, p};
-use daemon::offline::edit::{edit_take, EditRequest};
+use daemon::offline::edit::{self, edit_take, EditRequest};
 use daemon::offline::progress::Silent;
 use daemon::offline::{self, streamed};
 use ica_core::model::IcaModel;
@@ -95,7 +95,7 @@ fn check_edit(model: (&Path, &IcaModel), input: &Path, request: &EditRequest, fo
     replay::save(&expected, &whole).expect("whole written");
     let exact = Format::from_path(input) != Some(Format::Csv) || format == Format::Csv;
     for block in [1, 7, 100_000] {
-        let s = streamed::edit_file(model, (input, LIMIT), request, &out, block, &mut Silent)
+        let s = edit::edit_file(model, (input, LIMIT), request, &out, block, &mut Silent)
             .expect("streamed edit");
         assert_eq!(s.frames, take.n_frames());
         assert!(s.notices.is_empty(), "{:?}", s.notices);
@@ -209,7 +209,7 @@ fn streamed_projection_is_the_whole_take_projection_and_failures_leave_no_file()
         ..EditRequest::default()
     };
     let m = (dir.path().join("model.json"), &model);
-    let e = streamed::edit_file(
+    let e = edit::edit_file(
         (&m.0, m.1),
         (&cut, LIMIT),
         &request,
@@ -251,7 +251,7 @@ fn a_take_whose_markers_or_rate_differ_from_the_model_is_named_in_the_notices() 
         ..EditRequest::default()
     };
     let edited = dir.path().join("e.c3d");
-    let s = streamed::edit_file(
+    let s = edit::edit_file(
         (&model_path, &model),
         (&input, LIMIT),
         &request,

@@ -22,7 +22,7 @@
 use nalgebra::{DMatrix, DMatrixView};
 
 use super::kernels::{all_finite, centre_into};
-use super::pca::frame_is_used;
+use super::stats::frame_is_used;
 use super::syrk::{accumulate_upper, rank_one_upper};
 use crate::input::{FitData, FitError};
 

@@ -4,6 +4,7 @@
 
 use nalgebra::DMatrix;
 
+use super::stats::frame_is_used;
 use super::{eigen, Components, Moments, DEAD_CHANNEL_RELATIVE_VARIANCE, RANK_RELATIVE_EIGENVALUE};
 use crate::input::FitError;
 
@@ -154,14 +155,6 @@ fn sign_axes(basis: &mut DMatrix<f64>) {
         if axis[axis.iamax()] < 0.0 {
             axis.neg_mut();
         }
-    }
-}
-
-/// A frame is used when its missing channels are exactly those missing everywhere.
-pub(crate) fn frame_is_used(missing_everywhere: &[bool], missing: Option<&[bool]>) -> bool {
-    match missing {
-        None => !missing_everywhere.contains(&true),
-        Some(flags) => flags == missing_everywhere,
     }
 }
 

@@ -8,6 +8,14 @@ use crate::linalg::mul_add;
 
 use crate::input::{FitData, FitError};
 
+/// A frame is used when its missing channels are exactly those missing everywhere.
+pub(crate) fn frame_is_used(missing_everywhere: &[bool], missing: Option<&[bool]>) -> bool {
+    match missing {
+        None => !missing_everywhere.contains(&true),
+        Some(flags) => flags == missing_everywhere,
+    }
+}
+
 /// Frames gathered per gemm call: large enough to amortise packing, small enough to stay in cache.
 const CHUNK_FRAMES: usize = 256;
 

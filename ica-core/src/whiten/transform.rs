@@ -3,7 +3,7 @@
 
 use nalgebra::DMatrixView;
 
-use super::pca::frame_is_used;
+use super::stats::frame_is_used;
 use super::Whitener;
 use crate::input::{FitData, FitError};
 use crate::linalg::mul_add;

@@ -25,51 +25,13 @@
 //! assert_eq!(seen, 5);
 //! ```
 
-mod write;
-
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 
-pub use self::write::TakeWriter;
 use crate::error::ReadError;
-use crate::{c3d, csv, trc, Format, Take, Units};
+use crate::{c3d, csv, trc, Format, Take};
 
-/// What a take file says before its frames.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TakeHeader {
-    /// Marker labels, in file order.
-    pub labels: Vec<String>,
-    /// Frame rate; `None` for a CSV file without `rate_hz`, whose rate is derived from its
-    /// time column once every row is read.
-    pub rate_hz: Option<f64>,
-    /// Number of the first frame (1 for a file with no frames).
-    pub first_frame: i64,
-    /// Frames the file declares (C3D, TRC); `None` where the format does not say (CSV).
-    pub frames: Option<usize>,
-    /// Units the file declared (values are read in millimetres).
-    pub source_units: Units,
-}
-
-impl TakeHeader {
-    /// A take with no frames and this header's labels, rate (1 Hz when not yet known), first
-    /// frame and units: the block buffer to pass to [`BlockReader::read_block`].
-    pub fn empty_take(&self) -> Take {
-        let mut take = Take::new(
-            self.labels.clone(),
-            self.rate_hz.unwrap_or(1.0),
-            self.first_frame,
-        );
-        take.source_units = self.source_units;
-        take
-    }
-
-    /// Checks the header against the take invariants that do not depend on frames (labels,
-    /// rate), so a block reader refuses a bad file before its first block.
-    pub(crate) fn validate(&self) -> Result<(), ReadError> {
-        self.empty_take().validate()?;
-        Ok(())
-    }
-}
+pub use crate::take::TakeHeader;
 
 /// A take file read block by block; see the module docs.
 #[derive(Debug)]

@@ -1,6 +1,6 @@
 //! Byte order and float encodings of the three C3D processor types, and the 512-byte header.
 
-use super::error::C3dError;
+use crate::error::c3d::C3dError;
 
 /// Bytes in one C3D block; headers, parameters and data all start on block boundaries.
 pub const BLOCK: usize = 512;

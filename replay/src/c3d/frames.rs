@@ -7,11 +7,11 @@
 use std::io::{BufRead, Chain, Cursor, Read};
 
 use super::binary::{self, BLOCK};
-use super::error::C3dError;
 use super::layout::Layout;
 use super::{decode, params};
-use crate::blocks::TakeHeader;
+use crate::error::c3d::C3dError;
 use crate::error::ReadError;
+use crate::take::TakeHeader;
 use crate::Take;
 
 /// A C3D file read frame block by frame block; see [`crate::blocks`].

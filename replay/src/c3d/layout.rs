@@ -2,8 +2,8 @@
 //! cross-check a damaged file can fail.
 
 use super::binary::{Header, Processor, BLOCK};
-use super::error::C3dError;
 use super::params::Params;
+use crate::error::c3d::C3dError;
 use crate::error::ReadError;
 use crate::Units;
 

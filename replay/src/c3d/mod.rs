@@ -13,7 +13,6 @@
 
 mod binary;
 mod decode;
-mod error;
 mod frames;
 mod layout;
 mod params;
@@ -21,9 +20,9 @@ pub(crate) mod write;
 
 use std::io::Read;
 
+pub use crate::error::c3d::{C3dError, C3dLimitError};
 pub use binary::Processor;
 pub use decode::{catching_c3dio_panic, Decoder};
-pub use error::{C3dError, C3dLimitError};
 pub use frames::C3dBlocks;
 pub use write::write;
 
@@ -62,7 +61,7 @@ pub fn read(mut input: impl Read) -> Result<Take, ReadError> {
 ///
 /// # Errors
 /// As [`read`], for the header and parameter section.
-pub fn read_time(bytes: &[u8]) -> Result<crate::record::RecordTime, ReadError> {
+pub fn read_time(bytes: &[u8]) -> Result<crate::take::RecordTime, ReadError> {
     let (processor, header) = binary::parse_header(bytes)?;
     let params = params::parse(bytes, header.parameter_block, header.data_block, processor)?;
     let camera_rate_hz = params.number("TRIAL", "CAMERA_RATE", false);
@@ -102,7 +101,7 @@ pub fn read_time(bytes: &[u8]) -> Result<crate::record::RecordTime, ReadError> {
         }
         _ => None,
     };
-    Ok(crate::record::RecordTime {
+    Ok(crate::take::RecordTime {
         timecode,
         camera_rate_hz,
     })

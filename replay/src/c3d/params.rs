@@ -2,7 +2,7 @@
 //! 3D points when c3dio refuses a file, and to validate what c3dio returns.
 
 use super::binary::{take2, take4, Processor, BLOCK};
-use super::error::C3dError;
+use crate::error::c3d::C3dError;
 
 /// The value of one parameter.
 #[derive(Debug, Clone, PartialEq)]

@@ -5,8 +5,8 @@ use std::io::BufRead;
 
 use super::header::{parse_comment, parse_header, Meta};
 use super::rate;
-use crate::blocks::TakeHeader;
 use crate::error::ReadError;
+use crate::take::TakeHeader;
 use crate::trc::row_blocks::{NextRow, RowBlocks};
 use crate::trc::text::{self, check_frame_number, parse_time, Lines};
 use crate::{Take, Units};

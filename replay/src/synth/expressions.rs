@@ -14,7 +14,7 @@
 //! Every field moves several regions, so no emotion is confined to one of them.
 
 use super::geometry::{Marker, Region, MOUTH_HALF_WIDTH, MOUTH_Y};
-use super::mixing::{bump, corner_share, label_starts, side, smoothstep};
+use super::shapes::{bump, corner_share, label_starts, side, smoothstep};
 
 /// A field: displacement of one marker per unit of its source, mm.
 pub(crate) type Field = fn(&Marker) -> [f64; 3];

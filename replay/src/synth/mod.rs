@@ -49,6 +49,7 @@ pub mod mixing;
 pub mod render;
 mod seeds;
 pub mod session_io;
+mod shapes;
 pub mod sources;
 pub mod space;
 pub mod speech;

@@ -6,8 +6,8 @@ use std::io::BufRead;
 use super::header::read_header;
 use super::row_blocks::{NextRow, RowBlocks};
 use super::text::{self, check_frame_number, parse_time, Lines};
-use crate::blocks::TakeHeader;
 use crate::error::ReadError;
+use crate::take::TakeHeader;
 use crate::Take;
 
 /// A TRC file read row block by row block; see [`crate::blocks`].

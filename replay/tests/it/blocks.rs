@@ -3,8 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use replay::blocks::{BlockReader, TakeWriter};
+use replay::blocks::BlockReader;
 use replay::c3d::C3dError;
+use replay::TakeWriter;
 use replay::{Format, ReadError, Take};
 
 const FORMATS: [Format; 3] = [Format::C3d, Format::Trc, Format::Csv];

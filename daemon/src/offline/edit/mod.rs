@@ -24,8 +24,10 @@ use ica_core::project::Projector;
 use replay::Take;
 
 mod output;
+mod streamed;
 
 pub(crate) use self::output::Output;
+pub use self::streamed::{edit_file, EditSummary};
 use crate::offline::analysis::DTW_BAND_SHARE;
 use crate::offline::{self, ModelFrames, Projected};
 use engine::edit_state::EditState;

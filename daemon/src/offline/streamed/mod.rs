@@ -4,7 +4,7 @@
 //! components) crosses block boundaries untouched, so the output is the whole-take path's.
 //!
 //! - [`project_file`]: one pass.
-//! - [`edit_file`]: one pass, or two for `--to-emotion` without `--lowpass`, whose offset needs
+//! - [`crate::offline::edit::edit_file`] (which lives with the edits): one pass, or two for `--to-emotion` without `--lowpass`, whose offset needs
 //!   the take's mean components (the first pass sums them; the file is read again).
 //! - Copy & Replace and Copy & Add align another take to all of this one (DTW) and stay on the
 //!   whole-take path ([`crate::offline::edit::edit_take`]).
@@ -14,12 +14,10 @@
 //! Outputs are written to a hidden file beside the output and renamed over it when complete:
 //! a failure half way (a truncated input) leaves no partial file.
 
-mod edit;
 mod output;
 mod project;
 mod source;
 
-pub use edit::{edit_file, EditSummary};
 pub use project::{project_file, ProjectSummary};
 
 use anyhow::{Context, Result};

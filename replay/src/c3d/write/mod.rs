@@ -3,7 +3,7 @@
 use std::io::Write;
 
 use super::binary::{BLOCK, SIGNATURE};
-use super::error::C3dLimitError;
+use crate::error::c3d::C3dLimitError;
 use crate::error::WriteError;
 use crate::Take;
 
@@ -106,7 +106,7 @@ pub(crate) struct Meta<'a> {
     /// Frame rate, Hz.
     pub(crate) rate_hz: f64,
     /// A recording's timecode and measured rate.
-    pub(crate) time: Option<&'a crate::record::RecordTime>,
+    pub(crate) time: Option<&'a crate::take::RecordTime>,
 }
 
 /// Rejects labels C3D cannot hold: too many markers, a label over 255 bytes.
@@ -254,11 +254,12 @@ fn header(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> [u8; BLOCK] {
 }
 
 mod params;
+mod records;
 mod timecode;
 
 use params::parameters;
 #[cfg(test)]
-use params::Records;
+use records::Records;
 
 #[cfg(test)]
 mod tests {

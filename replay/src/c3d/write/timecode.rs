@@ -1,6 +1,6 @@
 //! The TIMECODE group of a recording's C3D file (issue 16), Vicon's convention.
 
-use super::params::Records;
+use super::records::Records;
 
 /// Group id.
 const TIMECODE: i8 = 5;

@@ -1,5 +1,7 @@
 //! Errors of reading, writing and validating takes.
 
+pub mod c3d;
+
 use std::path::PathBuf;
 
 /// A broken invariant of an in-memory [`Take`](crate::Take).
@@ -73,7 +75,7 @@ pub enum ReadError {
     UnknownUnits(String),
     /// A C3D file is damaged or inconsistent; the error names what.
     #[error(transparent)]
-    C3d(#[from] crate::c3d::C3dError),
+    C3d(#[from] c3d::C3dError),
     /// The content parsed but breaks a take invariant.
     #[error(transparent)]
     Invalid(#[from] TakeError),
@@ -197,7 +199,7 @@ pub enum WriteError {
     Unrepresentable(String),
     /// The take exceeds what a C3D file can hold.
     #[error(transparent)]
-    C3dLimit(#[from] crate::c3d::C3dLimitError),
+    C3dLimit(#[from] c3d::C3dLimitError),
     /// A marker label holds a character the text format uses as a separator.
     #[error(
         "marker label {label:?} contains {forbidden:?}, which {format} cannot hold in a label"

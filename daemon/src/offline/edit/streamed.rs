@@ -5,11 +5,13 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use ica_core::model::IcaModel;
-use replay::blocks::TakeWriter;
+use replay::TakeWriter;
 
-use super::{label_map, run_pass, source_notices, Frame, FrameSink, PendingOut, Source};
-use crate::offline::edit::{plan, ComponentSums, EditRequest, FrameEditor, Output};
+use super::{plan, ComponentSums, EditRequest, FrameEditor, Output};
 use crate::offline::progress::Progress;
+use crate::offline::streamed::{
+    label_map, run_pass, source_notices, Frame, FrameSink, PendingOut, Source,
+};
 use engine::frame::FrameProcessor;
 
 /// What [`edit_file`] did.
