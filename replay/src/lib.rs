@@ -2,7 +2,7 @@
 //!
 //! Main types: [`Take`] (labels, rate, first frame, positions in mm, missing mask), [`Format`],
 //! [`load`] and [`save`]; [`pacer::Pacer`], the sans-IO schedule `emoshift replay` sends a take
-//! on; [`record::Recorder`], which writes a take frame by frame as it arrives;
+//! on; [`recorder::Recorder`], which writes a take frame by frame as it arrives;
 //! [`blocks::BlockReader`] and [`TakeWriter`], which read and write a take in blocks of
 //! frames so a long take never has to be held whole.
 //!
@@ -16,7 +16,7 @@ pub mod error;
 pub mod file;
 pub mod format;
 pub mod pacer;
-pub mod record;
+pub mod recorder;
 mod resample;
 pub mod session;
 pub mod synth;

@@ -233,7 +233,7 @@ pub struct RecordTime {
     /// group; with it a CSV recording has a `timecode` column, one per frame.
     pub timecode: Option<protocol::Smpte>,
     /// The rate measured from the source (C3D `TRIAL:CAMERA_RATE`, TRC `CameraRate`); may
-    /// also be set before finishing ([`crate::record::Recorder::set_camera_rate`]).
+    /// also be set before finishing ([`crate::recorder::Recorder::set_camera_rate`]).
     pub camera_rate_hz: Option<f64>,
 }
 

@@ -9,7 +9,7 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use crate::error::{TakeError, WriteError};
-use crate::record::Recorder;
+use crate::recorder::Recorder;
 use crate::{c3d, csv, trc, Format, Take};
 
 /// Write buffer of the exact writer: large writes, few system calls.

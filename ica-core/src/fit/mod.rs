@@ -46,7 +46,7 @@ mod amari;
 mod assemble;
 mod params;
 mod source;
-mod stream;
+mod streamed;
 
 pub use crate::input::Pass;
 pub use crate::input::{FitData, FitError};
@@ -54,7 +54,7 @@ pub use crate::mixture;
 pub use amari::amari_index;
 pub use params::{FastIcaParams, DEFAULT_MAX_ITER, DEFAULT_RESTARTS, DEFAULT_SEED, DEFAULT_TOL};
 pub use source::{ChunkSource, MemorySource, MemoryStore, StreamError, WhitenedStore};
-pub use stream::StreamFit;
+pub use streamed::StreamFit;
 
 pub use crate::fastica::{Algorithm, Contrast};
 pub use crate::whiten::Components;

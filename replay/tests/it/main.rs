@@ -8,7 +8,7 @@ mod blocks;
 mod c3d;
 mod c3d_samples;
 mod pacer;
-mod record;
+mod recorder;
 mod synth;
 mod synth_pins;
 mod synth_space;

@@ -17,11 +17,11 @@ mod html;
 mod map;
 pub mod space;
 mod stats;
-mod stream;
+mod streamed;
 mod svg;
 
 pub use stats::{SessionStats, TakeSeries};
-pub use stream::analyze_session;
+pub use streamed::analyze_session;
 pub use svg::{timeline_takes, TimelineTake};
 
 use std::collections::BTreeMap;

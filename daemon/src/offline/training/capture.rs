@@ -1,7 +1,7 @@
 //! What preparing learns from the capture before it prepares any frame: the head reference and
 //! its template, then the glitch limits (speed, plausible regions) measured in head
 //! coordinates. The in-memory path learns them from every frame; streaming training from a
-//! bounded sample of whole stretches of takes ([`super::stream`]), the same function on fewer
+//! bounded sample of whole stretches of takes ([`super::streamed`]), the same function on fewer
 //! frames.
 
 use anyhow::Result;

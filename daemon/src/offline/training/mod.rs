@@ -21,7 +21,7 @@ mod glitches;
 pub mod head;
 mod model;
 pub mod quality;
-mod stream;
+mod streamed;
 
 use std::ops::Range;
 
@@ -35,7 +35,7 @@ use glitches::glitches_per_marker;
 pub use glitches::{AUTO_SPEED_FACTOR, BOUNDS_FACTOR, MIN_AUTO_SPEED_MM_S, MIN_BOUNDS_MM};
 pub use head::{HeadChoice, DEFAULT_HEAD_PATTERNS};
 pub use model::{train, PrepReport, Stage, TrainOptions, Trained};
-pub use stream::{train_files, StreamOptions, IN_MEMORY_FRAMES, SAMPLE_FRAMES};
+pub use streamed::{train_files, StreamOptions, IN_MEMORY_FRAMES, SAMPLE_FRAMES};
 
 use crate::offline::{self, LoadedTake, ModelFrames};
 use engine::frame::FramePrep;

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use protocol::{FrameBuf, FrameHeader, Smpte};
-use replay::record::{RecordSummary, RecordTime, Recorder};
+use replay::recorder::{RecordSummary, RecordTime, Recorder};
 
 /// Frames held to measure the rate of a source that does not announce it.
 pub const MEASURE_FRAMES: usize = 240;

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use protocol::Smpte;
-use replay::record::{RecordTime, Recorder};
+use replay::recorder::{RecordTime, Recorder};
 
 use super::RecordError;
 

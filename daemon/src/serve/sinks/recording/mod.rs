@@ -124,7 +124,7 @@ impl StreamFiles {
     }
 }
 
-/// One recording in progress (bounded memory: [`replay::record::Recorder`] streams to disk).
+/// One recording in progress (bounded memory: [`replay::recorder::Recorder`] streams to disk).
 #[derive(Debug)]
 pub struct Recording {
     path: PathBuf,

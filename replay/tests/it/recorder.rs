@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use replay::c3d::C3dLimitError;
-use replay::record::Recorder;
+use replay::recorder::Recorder;
 use replay::{Take, WriteError};
 
 /// `frames` frames of three markers with gaps: marker 1 missing every 5th frame, marker 2 for a
@@ -228,7 +228,7 @@ fn frames_reach_the_file_as_they_are_pushed() {
 #[test]
 fn timecode_and_measured_rate_go_into_every_format() {
     use protocol::{Smpte, TimecodeRate};
-    use replay::record::RecordTime;
+    use replay::recorder::RecordTime;
     let dir = tempfile::tempdir().unwrap();
     let labels = vec!["Chin".to_string(), "Nose".to_string()];
     let rate = TimecodeRate::DF_29_97;

@@ -1,7 +1,7 @@
 //! A streaming recorder: writes a take to C3D, TRC or CSV frame by frame, in bounded memory.
 //!
 //! ```
-//! use replay::record::Recorder;
+//! use replay::recorder::Recorder;
 //!
 //! let dir = tempfile::tempdir().expect("temp dir");
 //! let path = dir.path().join("live.trc");
@@ -46,7 +46,6 @@ pub use crate::take::RecordTime;
 use crate::trc::text::{check_labels, push_sample};
 use crate::{Format, Take};
 
-#[path = "record_trc.rs"]
 mod trc_header;
 use trc_header::{trc_header, COUNT_WIDTH, RATE_WIDTH};
 
