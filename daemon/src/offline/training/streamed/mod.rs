@@ -138,15 +138,7 @@ fn streamed(
     progress: &mut dyn Progress,
 ) -> Result<Trained> {
     progress.step("learning the head and glitch limits", "frames", None);
-    let learned = pool.install(|| {
-        capture::learn(
-            &scanned.sample,
-            &scanned.labels,
-            &scanned.excluded,
-            scanned.rate_hz,
-            &options.prep,
-        )
-    })?;
+    let learned = pool.install(|| learn(&scanned, options))?;
     let total = scanned.total_frames();
     let (scanned, raw) = scanned.take_raw()?;
     let (mut collected, head_residuals) = statistics(&scanned, raw, &learned, pool, progress)?;
@@ -181,6 +173,58 @@ fn streamed(
         progress,
     )?;
     progress.finish();
+    let residuals = residuals.context("the residuals were measured alongside the fit")?;
+    let (head, measures) = measured(&learned, head_residuals, residuals, noise_mm);
+    let model = fitted_model(&scanned, &learned, fit, (&head, measures), options)?;
+    let capped_at_noise = capped_at_noise(&params, &model);
+    let data = prep_report(scanned, learned, &collected, &model, head);
+    Ok(Trained {
+        model,
+        data,
+        gaps: filled.report,
+        noise_mm,
+        capped_at_noise,
+    })
+}
+
+/// The head reference and glitch limits, learned from the scan's sample.
+fn learn(scanned: &scan::Scan, options: &TrainOptions) -> Result<capture::Learned> {
+    capture::learn(
+        &scanned.sample,
+        &scanned.labels,
+        &scanned.excluded,
+        scanned.rate_hz,
+        &options.prep,
+    )
+}
+
+/// The head report with the residuals measured over the session, and the quality measures.
+fn measured(
+    learned: &capture::Learned,
+    head_residuals: Option<BTreeMap<String, f64>>,
+    (residual_by_marker_mm, slow_residual): (Vec<f64>, Option<(f64, usize)>),
+    noise_mm: f64,
+) -> (ica_core::quality::HeadReport, Measures) {
+    let mut head = learned.head.clone();
+    if let Some(residuals) = head_residuals {
+        head.residual_mm = residuals;
+    }
+    let measures = Measures {
+        residual_by_marker_mm,
+        slow_residual,
+        noise_mm,
+    };
+    (head, measures)
+}
+
+/// The fitted model, with its capture settings and quality report.
+fn fitted_model(
+    scanned: &scan::Scan,
+    learned: &capture::Learned,
+    fit: ica_core::fit::FitOutput,
+    (head, measures): (&ica_core::quality::HeadReport, Measures),
+    options: &TrainOptions,
+) -> Result<IcaModel> {
     let mut model = IcaModel::new(
         scanned.labels.clone(),
         scanned.rate_hz,
@@ -190,25 +234,24 @@ fn streamed(
     )
     .context("the fitted model failed validation")?;
     model.set_capture(learned.capture.clone())?;
-    let mut head = learned.head.clone();
-    if let Some(residuals) = head_residuals {
-        head.residual_mm = residuals;
-    }
-    let (residual_by_marker_mm, slow_residual) =
-        residuals.context("the residuals were measured alongside the fit")?;
-    let measures = Measures {
-        residual_by_marker_mm,
-        slow_residual,
-        noise_mm,
-    };
     model.set_quality(quality::assess_measured(
         &model,
-        &head,
+        head,
         measures,
         options.regions.as_ref(),
     ));
-    let capped_at_noise = capped_at_noise(&params, &model);
-    let data = PrepReport {
+    Ok(model)
+}
+
+/// What the streamed preparation found, for the report.
+fn prep_report(
+    scanned: scan::Scan,
+    learned: capture::Learned,
+    collected: &Collected,
+    model: &IcaModel,
+    head: ica_core::quality::HeadReport,
+) -> PrepReport {
+    PrepReport {
         labels: scanned.labels,
         rate_hz: scanned.rate_hz,
         capture: learned.capture,
@@ -216,7 +259,7 @@ fn streamed(
         label_notes: scanned.label_notes,
         resampled: scanned.resampled,
         glitches: collected.glitches,
-        glitches_per_marker: collected.glitches_per_marker,
+        glitches_per_marker: collected.glitches_per_marker.clone(),
         residual_summary: residual_summary(&collected.residuals.values),
         reference: learned
             .reference
@@ -224,14 +267,7 @@ fn streamed(
             .map(|&i| model.labels()[i].clone())
             .collect(),
         head,
-    };
-    Ok(Trained {
-        model,
-        data,
-        gaps: filled.report,
-        noise_mm,
-        capped_at_noise,
-    })
+    }
 }
 
 /// Each marker's RMS residual over the residual frames (`channels` values each), and the slow

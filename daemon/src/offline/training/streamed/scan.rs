@@ -51,6 +51,24 @@ pub(super) struct Scan {
 }
 
 impl Scan {
+    /// A scan of `takes` takes at `rate_hz`, the first of `first_markers` markers, holding
+    /// the takes when `hold`.
+    fn new(rate_hz: f64, takes: usize, first_markers: usize, hold: bool) -> Scan {
+        Scan {
+            rate_hz,
+            labels: Vec::new(),
+            excluded: Vec::new(),
+            label_notes: Vec::new(),
+            resampled: Vec::new(),
+            take_frames: Vec::with_capacity(takes),
+            sample: Vec::new(),
+            first_markers,
+            kept: Vec::new(),
+            raw: None,
+            held: hold.then(Vec::new),
+        }
+    }
+
     /// The spilled frames, taken out (the rest of the scan stays usable).
     pub(super) fn take_raw(mut self) -> Result<(Self, Spill)> {
         let raw = self.raw.take().context("the frames were spilled once")?;
@@ -82,41 +100,12 @@ pub(super) fn scan(
     let first = load_take_with(first_path, super::DECODING)?;
     let rate_hz = prep.rate_hz.unwrap_or(first.rate_hz);
     let first_labels = first.labels.clone();
-    let sizes: Vec<u64> = paths
-        .iter()
-        .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
-        .collect();
-    // Holding takes that are dropped later only costs: hold none when the first take's
-    // frames per byte (at the model rate) say the session is well past the limit. A wrong
-    // guess costs time, not the model: a short session found streamed is read again.
-    let likely_frames =
-        first.n_frames() as f64 * (rate_hz / first.rate_hz) * sizes.iter().sum::<u64>() as f64
-            / sizes.first().copied().unwrap_or(1).max(1) as f64;
-    let hold = likely_frames <= 2.0 * hold_frames as f64;
-    // The sampler's first stride trusts the guess only where the files are alike: a C3D first
-    // take among CSV or TRC ones (several times the bytes per frame) would make the guess, and
-    // the stride, several times too large, and the sample that much too small. Otherwise the
-    // stride only doubles, which keeps at least half the budget.
-    let alike = paths
-        .iter()
-        .all(|p| p.extension() == first_path.extension());
-    let sample_guess = if alike { likely_frames } else { 0.0 };
+    let sizes = file_sizes(paths);
+    let (hold, sample_guess) = session_guess(paths, &sizes, &first, rate_hz, hold_frames);
     drop(first);
     let mut counts = MissingCounts::new(first_labels.clone());
     let mut sampler = Sampler::new(sample_frames, sample_guess);
-    let mut scan = Scan {
-        rate_hz,
-        labels: Vec::new(),
-        excluded: Vec::new(),
-        label_notes: Vec::new(),
-        resampled: Vec::new(),
-        take_frames: Vec::with_capacity(paths.len()),
-        sample: Vec::new(),
-        first_markers: first_labels.len(),
-        kept: Vec::new(),
-        raw: None,
-        held: hold.then(Vec::new),
-    };
+    let mut scan = Scan::new(rate_hz, paths.len(), first_labels.len(), hold);
     let mut bytes = Vec::new();
     let mut raw = Spill::new(first_labels.len() * 13)?;
     let load = |i: usize| {
@@ -136,32 +125,12 @@ pub(super) fn scan(
                         .push((path.display().to_string(), original.rate_hz, rate_hz));
                 }
                 let take = at_rate.as_ref().unwrap_or(&original);
-                counts
-                    .add(take, &path.display().to_string())
-                    .with_context(|| format!("{}", path.display()))?;
-                let map = LabelMap::new(&first_labels, &take.labels)
-                    .with_context(|| format!("{}", path.display()))?;
-                let all = frames_in_model_order(take, &map, 0..take.n_frames());
+                let all = first_take_order(path, take, &first_labels, &mut counts)?;
                 sampler.push(i, all.frames(), &|r| frames_range(&all, r));
-                bytes.clear();
-                for f in 0..all.frames() {
-                    let (xyz, missing) = all.frame(f);
-                    f32_bytes(xyz, &mut bytes);
-                    bytes.extend(missing.iter().map(|&m| u8::from(m)));
-                }
-                raw.push(&bytes)?;
+                spill_frames(&all, &mut bytes, &mut raw)?;
                 scan.take_frames.push(take.n_frames());
-                scan.held = match scan.held.take() {
-                    Some(mut held) if scan.take_frames.iter().sum::<usize>() <= hold_frames => {
-                        // The in-memory path resamples by itself.
-                        held.push(LoadedTake {
-                            path: path.clone(),
-                            take: original,
-                        });
-                        Some(held)
-                    }
-                    _ => None,
-                };
+                let total = scan.take_frames.iter().sum::<usize>();
+                scan.held = hold_take(scan.held.take(), total <= hold_frames, path, original);
                 progress.advance(1);
             }
             Ok(())
@@ -170,19 +139,105 @@ pub(super) fn scan(
     let kept = counts.kept(prep.max_missing_share)?;
     let (labels, excluded) = (kept.labels, kept.excluded);
     scan.label_notes = kept.label_notes;
-    let kept: Vec<usize> = labels
-        .iter()
-        .map(|l| {
-            first_labels
-                .iter()
-                .position(|f| f == l)
-                .expect("kept labels come from the first take's")
-        })
-        .collect();
+    let kept = positions_in(&labels, &first_labels);
     scan.raw = Some(raw);
     scan.sample = sampler.finish(&kept);
     scan.kept = kept;
     scan.labels = labels;
     scan.excluded = excluded;
     Ok(scan)
+}
+
+/// Each file's size in bytes (1 when it cannot be read: the reading will say why).
+fn file_sizes(paths: &[PathBuf]) -> Vec<u64> {
+    paths
+        .iter()
+        .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
+        .collect()
+}
+
+/// `take`'s frames in the first take's marker order, its missing markers counted.
+fn first_take_order(
+    path: &std::path::Path,
+    take: &replay::Take,
+    first_labels: &[String],
+    counts: &mut MissingCounts,
+) -> Result<ModelFrames> {
+    counts
+        .add(take, &path.display().to_string())
+        .with_context(|| format!("{}", path.display()))?;
+    let map =
+        LabelMap::new(first_labels, &take.labels).with_context(|| format!("{}", path.display()))?;
+    Ok(frames_in_model_order(take, &map, 0..take.n_frames()))
+}
+
+/// Whether to hold the takes (the session looks short), and the sampler's guess at the
+/// session's frames.
+fn session_guess(
+    paths: &[PathBuf],
+    sizes: &[u64],
+    first: &replay::Take,
+    rate_hz: f64,
+    hold_frames: usize,
+) -> (bool, f64) {
+    // Holding takes that are dropped later only costs: hold none when the first take's
+    // frames per byte (at the model rate) say the session is well past the limit. A wrong
+    // guess costs time, not the model: a short session found streamed is read again.
+    let likely_frames =
+        first.n_frames() as f64 * (rate_hz / first.rate_hz) * sizes.iter().sum::<u64>() as f64
+            / sizes.first().copied().unwrap_or(1).max(1) as f64;
+    let hold = likely_frames <= 2.0 * hold_frames as f64;
+    // The sampler's first stride trusts the guess only where the files are alike: a C3D first
+    // take among CSV or TRC ones (several times the bytes per frame) would make the guess, and
+    // the stride, several times too large, and the sample that much too small. Otherwise the
+    // stride only doubles, which keeps at least half the budget.
+    let first_path = &paths[0];
+    let alike = paths
+        .iter()
+        .all(|p| p.extension() == first_path.extension());
+    (hold, if alike { likely_frames } else { 0.0 })
+}
+
+/// One take's frames, model order, as raw bytes into the spill.
+fn spill_frames(all: &ModelFrames, bytes: &mut Vec<u8>, raw: &mut Spill) -> Result<()> {
+    bytes.clear();
+    for f in 0..all.frames() {
+        let (xyz, missing) = all.frame(f);
+        f32_bytes(xyz, bytes);
+        bytes.extend(missing.iter().map(|&m| u8::from(m)));
+    }
+    raw.push(bytes)
+}
+
+/// The takes held so far with this one, while the session still fits (`fits`).
+fn hold_take(
+    held: Option<Vec<LoadedTake>>,
+    fits: bool,
+    path: &std::path::Path,
+    original: replay::Take,
+) -> Option<Vec<LoadedTake>> {
+    match held {
+        Some(mut held) if fits => {
+            // The in-memory path resamples by itself.
+            held.push(LoadedTake {
+                path: path.to_path_buf(),
+                take: original,
+            });
+            Some(held)
+        }
+        _ => None,
+    }
+}
+
+/// Where each of `labels` is among `first` (the first take's labels, which hold them all).
+fn positions_in(labels: &[String], first: &[String]) -> Vec<usize> {
+    labels
+        .iter()
+        .map(|l| {
+            first
+                .iter()
+                .position(|f| f == l)
+                .expect("kept labels come from the first take's")
+        })
+        .collect()
 }
