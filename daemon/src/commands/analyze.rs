@@ -92,6 +92,23 @@ pub(crate) fn analyze_and_write(
     let done = analysis::analyze_session(&inputs, &session, &regions, progress.as_mut());
     let (report, timeline) = super::progress::settle(progress.as_mut(), done)?;
     let written = analysis::write_report(to.dir, &report, &timeline)?;
+    print_table(&report)?;
+    print_fitted(&report, model.components())?;
+    if to.write_model {
+        analysis::write_into_model(&mut model, &report, to.axes)?;
+        let file = std::fs::File::create(model_path)
+            .with_context(|| format!("cannot write {}", model_path.display()))?;
+        model.save(std::io::BufWriter::new(file))?;
+        crate::out!("roles and levels written to {}", model_path.display());
+    }
+    for p in written {
+        crate::out!("wrote {}", p.display());
+    }
+    Ok(model)
+}
+
+/// The components' metrics, the emotion note and the levels, as `analyze` prints them.
+fn print_table(report: &analysis::Report) -> Result<()> {
     for c in &report.components {
         crate::out!(
             "c{:<2} {:<9} d_emotion {:>8} d_level {:>8} d_mouth {:>8.4} d_eyebrows {:>8.4} d_eyelids {:>8.4}",
@@ -121,16 +138,5 @@ pub(crate) fn analyze_and_write(
             }
         }
     }
-    print_fitted(&report, model.components())?;
-    if to.write_model {
-        analysis::write_into_model(&mut model, &report, to.axes)?;
-        let file = std::fs::File::create(model_path)
-            .with_context(|| format!("cannot write {}", model_path.display()))?;
-        model.save(std::io::BufWriter::new(file))?;
-        crate::out!("roles and levels written to {}", model_path.display());
-    }
-    for p in written {
-        crate::out!("wrote {}", p.display());
-    }
-    Ok(model)
+    Ok(())
 }

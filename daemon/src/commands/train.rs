@@ -229,6 +229,23 @@ fn print_preparation(data: &PrepReport) -> Result<()> {
             100.0 * share
         );
     }
+    crate::out!("{}", glitch_line(data));
+    crate::out!(
+        "head reference ({}): {}",
+        data.head.source,
+        data.head.verdict
+    );
+    if let Some((median, p95)) = data.residual_summary {
+        crate::out!(
+            "head stabilised on {}: residual median {median:.2} mm, p95 {p95:.2} mm",
+            data.reference.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// How many samples were glitches, by what rule, and the markers with the most.
+fn glitch_line(data: &PrepReport) -> String {
     let limit = match data.capture.max_speed_mm_s {
         Some(v) => format!("faster than {v:.0} mm/s"),
         None => "no speed limit".into(),
@@ -256,22 +273,10 @@ fn print_preparation(data: &PrepReport) -> Result<()> {
     } else {
         format!(" ({})", names.join(", "))
     };
-    crate::out!(
+    format!(
         "glitches: {} samples {limit}{bounds} treated as missing{detail}",
         data.glitches
-    );
-    crate::out!(
-        "head reference ({}): {}",
-        data.head.source,
-        data.head.verdict
-    );
-    if let Some((median, p95)) = data.residual_summary {
-        crate::out!(
-            "head stabilised on {}: residual median {median:.2} mm, p95 {p95:.2} mm",
-            data.reference.join(", ")
-        );
-    }
-    Ok(())
+    )
 }
 
 fn print_summary(model: &IcaModel, takes: usize, seconds: f64) -> Result<()> {

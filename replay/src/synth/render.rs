@@ -79,15 +79,7 @@ pub(crate) fn render(synth: &Synth, spec: &TakeSpec) -> Result<RenderedTake, Syn
             count: synth.sentences().len(),
         })?;
     check_levels(synth, &spec.emotion_levels)?;
-    let end = spec.warp.canonical_duration_s();
-    let ok = spec.warp.n_frames() >= 2 && (end - sentence.duration_s).abs() < 1e-6;
-    if !ok {
-        return Err(SynthError::WarpMismatch {
-            sentence: sentence.id.clone(),
-            warp_s: end,
-            sentence_s: sentence.duration_s,
-        });
-    }
+    check_warp(spec, sentence)?;
     let rate = synth.params().rate_hz;
     let n = spec.warp.n_frames();
     let cols = synth.source_layout();
@@ -130,6 +122,20 @@ pub(crate) fn render(synth: &Synth, spec: &TakeSpec) -> Result<RenderedTake, Syn
         segments: sentence.segments.clone(),
     };
     Ok(RenderedTake { take, truth })
+}
+
+/// The warp spans the sentence's canonical duration, over two frames at least.
+fn check_warp(spec: &TakeSpec, sentence: &super::speech::Sentence) -> Result<(), SynthError> {
+    let end = spec.warp.canonical_duration_s();
+    let ok = spec.warp.n_frames() >= 2 && (end - sentence.duration_s).abs() < 1e-6;
+    if !ok {
+        return Err(SynthError::WarpMismatch {
+            sentence: sentence.id.clone(),
+            warp_s: end,
+            sentence_s: sentence.duration_s,
+        });
+    }
+    Ok(())
 }
 
 /// One finite level per emotion direction.

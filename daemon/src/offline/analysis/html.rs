@@ -159,14 +159,9 @@ fn esc(text: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// The report page; it references `components.svg` and `timeline.svg` beside it.
-pub fn page(report: &Report) -> String {
+/// One table row per component: its role, d_emotion, d_level, each region's metric, |M_k|.
+fn metric_rows(report: &Report, regions: &[&String]) -> String {
     let mut rows = String::new();
-    let regions: Vec<&String> = report
-        .components
-        .first()
-        .map(|c| c.d_region.keys().collect())
-        .unwrap_or_default();
     for c in &report.components {
         let _ = write!(
             rows,
@@ -181,23 +176,43 @@ pub fn page(report: &Report) -> String {
             "<td>{}</td>",
             c.d_level.map_or("—".into(), |d| format!("{d:.4}"))
         );
-        for r in &regions {
+        for r in regions {
             let _ = write!(rows, "<td>{:.4}</td>", c.d_region[*r]);
         }
         let _ = write!(rows, "<td>{:.2}</td></tr>", c.mixing_norm_mm);
     }
-    let header: String = regions.iter().map(|r| format!("<th>d_{r}</th>")).collect();
-    let levels: String = report
+    rows
+}
+
+/// Each emotion's level as a list item.
+fn level_items(report: &Report) -> String {
+    report
         .levels
         .iter()
         .map(|(n, v)| format!("<li>{n}: {v:.4}</li>"))
-        .collect();
-    let t = &report.thresholds;
-    let note = if report.emotion_note.is_empty() {
+        .collect()
+}
+
+/// What the analysis says of the emotion component(s).
+fn emotion_note(report: &Report) -> String {
+    if report.emotion_note.is_empty() {
         format!("Emotion component(s): {:?}.", report.emotion_components)
     } else {
         report.emotion_note.clone()
-    };
+    }
+}
+
+/// The report page; it references `components.svg` and `timeline.svg` beside it.
+pub fn page(report: &Report) -> String {
+    let regions: Vec<&String> = report
+        .components
+        .first()
+        .map(|c| c.d_region.keys().collect())
+        .unwrap_or_default();
+    let rows = metric_rows(report, &regions);
+    let header: String = regions.iter().map(|r| format!("<th>d_{r}</th>")).collect();
+    let (levels, note) = (level_items(report), emotion_note(report));
+    let t = &report.thresholds;
     format!(
         r#"<!doctype html>
 <html><head><meta charset="utf-8"><title>emoshift analysis</title>

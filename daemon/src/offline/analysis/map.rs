@@ -60,6 +60,24 @@ fn project(p: &[f64], axis: &[f64], centre: &[f64]) -> f64 {
         .sum()
 }
 
+/// Each take as (its emotion's index among `names`, its point on the map).
+fn take_points(
+    report: &Report,
+    components: &[usize],
+    names: &[&String],
+    xy: &dyn Fn(&[f64]) -> (f64, f64),
+) -> Vec<(usize, (f64, f64))> {
+    report
+        .takes
+        .iter()
+        .filter_map(|t| {
+            let e = names.iter().position(|n| **n == t.emotion)?;
+            let p: Vec<f64> = components.iter().map(|&k| t.component_means[k]).collect();
+            Some((e, xy(&p)))
+        })
+        .collect()
+}
+
 /// The map, or `None` when the analysis found no emotion space.
 pub fn emotion_map(report: &Report) -> Option<String> {
     let space = report.space.as_ref()?;
@@ -70,19 +88,7 @@ pub fn emotion_map(report: &Report) -> Option<String> {
     let levels: Vec<Vec<f64>> = space.points.values().map(|p| p.level.clone()).collect();
     let (ax, ay, centre) = plane(&levels);
     let xy = |p: &[f64]| (project(p, &ax, &centre), project(p, &ay, &centre));
-    let takes: Vec<(usize, (f64, f64))> = report
-        .takes
-        .iter()
-        .filter_map(|t| {
-            let e = names.iter().position(|n| **n == t.emotion)?;
-            let p: Vec<f64> = space
-                .components
-                .iter()
-                .map(|&k| t.component_means[k])
-                .collect();
-            Some((e, xy(&p)))
-        })
-        .collect();
+    let takes = take_points(report, &space.components, &names, &xy);
     let all: Vec<(f64, f64)> = takes
         .iter()
         .map(|t| t.1)

@@ -182,15 +182,7 @@ impl SessionStats {
         // Region metrics and roles treat the emotion axes as the emotion set; components that
         // only shift a little with emotion keep their region role.
         let emotion = space.as_ref().map(|s| s.axes.clone()).unwrap_or_default();
-        let d_region: BTreeMap<String, Vec<f64>> = regions
-            .iter()
-            .map(|(name, markers)| {
-                let d = self
-                    .moments
-                    .region_distance(model.mixing(), markers, &emotion)?;
-                Ok((name.clone(), d))
-            })
-            .collect::<Result<_>>()?;
+        let d_region = region_distances(&self.moments, model, regions, &emotion)?;
         let rules = LabelRules::default();
         let roles = roles(m, &emotion, &d_region, &rules);
         let components = (0..m)
@@ -217,13 +209,7 @@ impl SessionStats {
             takes: self.takes.into_iter().map(|t| t.summary).collect(),
             thresholds: rules,
             dtw_band_share: DTW_BAND_SHARE,
-            regions: regions
-                .iter()
-                .map(|(n, idx)| {
-                    let labels = idx.iter().map(|&i| model.labels()[i].clone()).collect();
-                    (n.clone(), labels)
-                })
-                .collect(),
+            regions: region_labels(model, regions),
             quality: model.quality().clone(),
         })
     }
@@ -329,4 +315,35 @@ fn take_means(series: &[f64], m: usize) -> Vec<f64> {
         }
     }
     means
+}
+
+/// Each region's metric per component (Eq. 4 of the method), the emotion axes taken as
+/// the emotion set.
+fn region_distances(
+    moments: &ComponentMoments,
+    model: &ica_core::model::IcaModel,
+    regions: &BTreeMap<String, Vec<usize>>,
+    emotion: &[usize],
+) -> Result<BTreeMap<String, Vec<f64>>> {
+    regions
+        .iter()
+        .map(|(name, markers)| {
+            let d = moments.region_distance(model.mixing(), markers, emotion)?;
+            Ok((name.clone(), d))
+        })
+        .collect()
+}
+
+/// Each region's marker labels.
+fn region_labels(
+    model: &ica_core::model::IcaModel,
+    regions: &BTreeMap<String, Vec<usize>>,
+) -> BTreeMap<String, Vec<String>> {
+    regions
+        .iter()
+        .map(|(n, idx)| {
+            let labels = idx.iter().map(|&i| model.labels()[i].clone()).collect();
+            (n.clone(), labels)
+        })
+        .collect()
 }

@@ -23,9 +23,11 @@ use ica_core::model::IcaModel;
 use ica_core::project::Projector;
 use replay::Take;
 
+mod editor;
 mod output;
 mod streamed;
 
+pub(crate) use self::editor::FrameEditor;
 pub(crate) use self::output::Output;
 pub use self::streamed::{edit_file, EditSummary};
 use crate::offline::analysis::DTW_BAND_SHARE;
@@ -334,32 +336,6 @@ impl Plan {
             dt: (1.0 / model.rate_hz()) as f32,
             replace: std::mem::take(&mut self.replace),
         })
-    }
-}
-
-/// Edits one frame's components after another: the state that crosses frames (the live
-/// edit's low-pass) lives here, so a take edited in blocks gets the whole take's edit.
-pub(crate) struct FrameEditor {
-    edit: FrameEdit,
-    live: Option<EditState>,
-    dt: f32,
-    replace: Series,
-}
-
-impl FrameEditor {
-    /// Edits the components `u` of frame index `f` (counted from the take's first frame).
-    ///
-    /// # Errors
-    /// A replaced value the edit refuses.
-    pub(crate) fn apply(&mut self, f: usize, u: &mut [f32]) -> Result<()> {
-        for (k, values) in &self.replace {
-            self.edit.set_override(*k, Some(values[f] as f32))?;
-        }
-        self.edit.apply(u)?;
-        if let Some(state) = self.live.as_mut() {
-            state.apply(self.dt, u);
-        }
-        Ok(())
     }
 }
 

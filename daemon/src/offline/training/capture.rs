@@ -39,21 +39,7 @@ pub(super) fn learn(
     let n = labels.len();
     // 1. The head: decided on the raw frames, template from them (its Procrustes mean shrugs
     //    off rare glitches).
-    let held: usize = frames.iter().map(ModelFrames::frames).sum();
-    let (mut raw_xyz, mut raw_missing) = (
-        Vec::with_capacity(held * n * 3),
-        Vec::with_capacity(held * n),
-    );
-    for f in frames {
-        raw_xyz.extend_from_slice(&f.xyz);
-        raw_missing.extend_from_slice(&f.missing);
-    }
-    let mut ranges = Vec::with_capacity(frames.len());
-    let mut start = 0;
-    for f in frames {
-        ranges.push(start..start + f.frames());
-        start += f.frames();
-    }
+    let (raw_xyz, raw_missing, ranges) = concatenated(frames, n);
     let raw = MarkerFrames {
         xyz: &raw_xyz,
         missing: &raw_missing,
@@ -98,6 +84,30 @@ pub(super) fn learn(
         reference,
         head: decision.report,
     })
+}
+
+/// The sample's frames end to end (`n` markers each): positions, missing flags, and each
+/// stretch's range of frames.
+fn concatenated(
+    frames: &[ModelFrames],
+    n: usize,
+) -> (Vec<f32>, Vec<bool>, Vec<std::ops::Range<usize>>) {
+    let held: usize = frames.iter().map(ModelFrames::frames).sum();
+    let (mut raw_xyz, mut raw_missing) = (
+        Vec::with_capacity(held * n * 3),
+        Vec::with_capacity(held * n),
+    );
+    for f in frames {
+        raw_xyz.extend_from_slice(&f.xyz);
+        raw_missing.extend_from_slice(&f.missing);
+    }
+    let mut ranges = Vec::with_capacity(frames.len());
+    let mut start = 0;
+    for f in frames {
+        ranges.push(start..start + f.frames());
+        start += f.frames();
+    }
+    (raw_xyz, raw_missing, ranges)
 }
 
 /// RMS distance (mm) of each reference marker from its template place, over prepared

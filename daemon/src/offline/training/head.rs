@@ -239,26 +239,7 @@ fn from_geometry(labels: &[String], frames: &MarkerFrames<'_>) -> HeadDecision {
         ..HeadReport::default()
     };
     match choose(&search.candidates) {
-        Choice::Stabilise(a) => {
-            let mut report = with_numbers(base, &a);
-            report.markers = names(&a.markers, labels);
-            report.stabilised = true;
-            report.verdict = if a.rigid {
-                format!(
-                    "stabilised on a rigid group found in the capture: head motion {:.2} mm RMS, pose error at the face {:.2} mm",
-                    a.motion_mm, a.pose_error_mm
-                )
-            } else {
-                format!(
-                    "no rigid group within the capture's noise ({:.3} mm); stabilised on the least-deforming markers: they deform by {:.2} mm RMS, which costs about {:.2} mm of pose error at the face (head motion {:.2} mm RMS)",
-                    a.noise_mm, a.deformation_mm, a.pose_error_mm, a.motion_mm
-                )
-            };
-            HeadDecision {
-                markers: a.markers,
-                report,
-            }
-        }
+        Choice::Stabilise(a) => stabilised_on_found(base, a, labels),
         Choice::StillHead(a) => {
             let mut report = with_numbers(base, &a);
             report.markers = names(&a.markers, labels);
@@ -294,5 +275,27 @@ fn from_geometry(labels: &[String], frames: &MarkerFrames<'_>) -> HeadDecision {
                 ..base
             },
         },
+    }
+}
+
+/// Stabilised on the group the search found (rigid, or the least deforming).
+fn stabilised_on_found(base: HeadReport, a: GroupAssessment, labels: &[String]) -> HeadDecision {
+    let mut report = with_numbers(base, &a);
+    report.markers = names(&a.markers, labels);
+    report.stabilised = true;
+    report.verdict = if a.rigid {
+        format!(
+            "stabilised on a rigid group found in the capture: head motion {:.2} mm RMS, pose error at the face {:.2} mm",
+            a.motion_mm, a.pose_error_mm
+        )
+    } else {
+        format!(
+            "no rigid group within the capture's noise ({:.3} mm); stabilised on the least-deforming markers: they deform by {:.2} mm RMS, which costs about {:.2} mm of pose error at the face (head motion {:.2} mm RMS)",
+            a.noise_mm, a.deformation_mm, a.pose_error_mm, a.motion_mm
+        )
+    };
+    HeadDecision {
+        markers: a.markers,
+        report,
     }
 }

@@ -21,6 +21,7 @@
 //! with one thread or several.
 
 mod collect;
+mod finish;
 mod fit;
 mod gaps;
 mod read;
@@ -36,16 +37,15 @@ use anyhow::{Context, Result};
 use ica_core::measure::{
     noise_of_differences, slow_residual_of_means, Reconstruction, ResidualSums,
 };
-use ica_core::model::IcaModel;
 use rayon::ThreadPool;
 
 use super::capture::{self, RefResiduals};
 use super::model::{capped_at_noise, component_params};
-use super::quality::{self, Measures};
-use super::{residual_summary, PrepReport, Stage, TrainOptions, Trained};
+use super::{Stage, TrainOptions, Trained};
 use crate::offline::progress::Progress;
 use crate::offline::{load_take_with, LoadedTake};
 use collect::Collected;
+use finish::{fitted_model, measured, prep_report};
 use rayon::prelude::*;
 use read::{batches, TakePrep};
 
@@ -198,78 +198,6 @@ fn learn(scanned: &scan::Scan, options: &TrainOptions) -> Result<capture::Learne
     )
 }
 
-/// The head report with the residuals measured over the session, and the quality measures.
-fn measured(
-    learned: &capture::Learned,
-    head_residuals: Option<BTreeMap<String, f64>>,
-    (residual_by_marker_mm, slow_residual): (Vec<f64>, Option<(f64, usize)>),
-    noise_mm: f64,
-) -> (ica_core::quality::HeadReport, Measures) {
-    let mut head = learned.head.clone();
-    if let Some(residuals) = head_residuals {
-        head.residual_mm = residuals;
-    }
-    let measures = Measures {
-        residual_by_marker_mm,
-        slow_residual,
-        noise_mm,
-    };
-    (head, measures)
-}
-
-/// The fitted model, with its capture settings and quality report.
-fn fitted_model(
-    scanned: &scan::Scan,
-    learned: &capture::Learned,
-    fit: ica_core::fit::FitOutput,
-    (head, measures): (&ica_core::quality::HeadReport, Measures),
-    options: &TrainOptions,
-) -> Result<IcaModel> {
-    let mut model = IcaModel::new(
-        scanned.labels.clone(),
-        scanned.rate_hz,
-        fit.mean,
-        fit.mixing,
-        fit.report,
-    )
-    .context("the fitted model failed validation")?;
-    model.set_capture(learned.capture.clone())?;
-    model.set_quality(quality::assess_measured(
-        &model,
-        head,
-        measures,
-        options.regions.as_ref(),
-    ));
-    Ok(model)
-}
-
-/// What the streamed preparation found, for the report.
-fn prep_report(
-    scanned: scan::Scan,
-    learned: capture::Learned,
-    collected: &Collected,
-    model: &IcaModel,
-    head: ica_core::quality::HeadReport,
-) -> PrepReport {
-    PrepReport {
-        labels: scanned.labels,
-        rate_hz: scanned.rate_hz,
-        capture: learned.capture,
-        excluded: scanned.excluded,
-        label_notes: scanned.label_notes,
-        resampled: scanned.resampled,
-        glitches: collected.glitches,
-        glitches_per_marker: collected.glitches_per_marker.clone(),
-        residual_summary: residual_summary(&collected.residuals.values),
-        reference: learned
-            .reference
-            .iter()
-            .map(|&i| model.labels()[i].clone())
-            .collect(),
-        head,
-    }
-}
-
 /// Each marker's RMS residual over the residual frames (`channels` values each), and the slow
 /// residual of the blocks' means, against `model`'s reconstruction. The residual's two halves
 /// and the slow residual run at once; the halves are fixed, so the sums do not depend on the
@@ -299,6 +227,37 @@ fn residual_measures(
 /// A batch prepared and not yet collected: its index and its takes.
 type Prepared = Option<(usize, Vec<read::PreparedTake>)>;
 
+/// How the scanned takes are prepared, with what was learned from the sample.
+fn take_prep<'a>(scanned: &'a scan::Scan, learned: &'a capture::Learned) -> TakePrep<'a> {
+    TakePrep {
+        kept: &scanned.kept,
+        spilled_markers: scanned.first_markers,
+        rate_hz: scanned.rate_hz,
+        capture: &learned.capture,
+    }
+}
+
+/// The takes in batches of about [`BATCH_FRAMES`] frames, and each batch's frames.
+fn take_batches(frames: &[usize]) -> (Vec<std::ops::Range<usize>>, Vec<usize>) {
+    let sizes: Vec<u64> = frames.iter().map(|&f| f as u64).collect();
+    let batches = batches(&sizes, BATCH_FRAMES);
+    let groups = batches
+        .iter()
+        .map(|r| frames[r.clone()].iter().sum())
+        .collect();
+    (batches, groups)
+}
+
+/// Where each take of a batch starts in its bytes (`record` bytes a frame), and where the
+/// last ends.
+fn take_starts(frames: &[usize], record: usize) -> Vec<usize> {
+    let mut starts = vec![0];
+    for &f in frames {
+        starts.push(starts.last().copied().unwrap_or(0) + f * record);
+    }
+    starts
+}
+
 /// Pass 2: every spilled frame prepared and collected; each reference marker's residual.
 fn statistics(
     scanned: &scan::Scan,
@@ -312,19 +271,9 @@ fn statistics(
     // The prepared frames go over the raw ones: each batch is collected after it was read.
     let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz, &mut raw)?;
     let mut refs = learned.capture.head.as_ref().map(RefResiduals::new);
-    let prep = TakePrep {
-        kept: &scanned.kept,
-        spilled_markers: scanned.first_markers,
-        rate_hz: scanned.rate_hz,
-        capture: &learned.capture,
-    };
+    let prep = take_prep(scanned, learned);
     let frames = &scanned.take_frames;
-    let sizes: Vec<u64> = frames.iter().map(|&f| f as u64).collect();
-    let batches = batches(&sizes, BATCH_FRAMES);
-    let groups: Vec<usize> = batches
-        .iter()
-        .map(|r| frames[r.clone()].iter().sum())
-        .collect();
+    let (batches, groups) = take_batches(frames);
     let record = 13 * scanned.first_markers;
     // Each batch is prepared on the pool while the previous one is collected here, so the
     // pool does not wait for the collecting (which writes the prepared spill).
@@ -340,10 +289,7 @@ fn statistics(
         Ok(())
     };
     raw.for_each_group(&groups, &mut |b, bytes| {
-        let mut starts = vec![0];
-        for &f in &frames[batches[b].clone()] {
-            starts.push(starts.last().copied().unwrap_or(0) + f * record);
-        }
+        let starts = take_starts(&frames[batches[b].clone()], record);
         let prepare = || {
             pool.install(|| {
                 starts
