@@ -322,5 +322,4 @@ fn least_deforming(pairs: &PairTable, count: usize) -> Vec<usize> {
 }
 
 #[cfg(test)]
-#[path = "search_tests.rs"]
 mod tests;

@@ -124,20 +124,4 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Processor, Header), C3dError> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn vax_float_decodes_known_values() {
-        // 1.0 in VAX-F is 0x4080 0x0000 (word order: high word first, each word little-endian).
-        assert_eq!(Processor::Dec.f32([0x80, 0x40, 0, 0]), 1.0);
-        assert_eq!(Processor::Dec.f32([0, 0, 0, 0]), 0.0);
-        assert_eq!(Processor::Dec.f32([0x80, 0xC0, 0, 0]), -1.0);
-    }
-
-    #[test]
-    fn mips_is_big_endian() {
-        assert_eq!(Processor::Mips.i16([0x01, 0x02]), 0x0102);
-        assert_eq!(Processor::Mips.f32(1.5f32.to_be_bytes()), 1.5);
-    }
-}
+mod tests;
