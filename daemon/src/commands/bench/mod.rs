@@ -236,9 +236,9 @@ fn print_max_rate(max: &Run) -> Result<()> {
     crate::out!(
         "  lost at the daemon's socket {}, dropped in the daemon {} (queue full {}, stale {}), \
          not sent {}, lost at the receiver's socket {}",
-        // Queue drops happen before the pipeline counts a frame in.
-        max.sent as i64 - frames_in - max.get("frames_dropped"),
-        frames_in - max.get("frames_out") + max.get("frames_dropped"),
+        // The source counts a frame in as it decodes it, before the queue may drop it.
+        max.sent as i64 - frames_in,
+        frames_in - max.get("frames_out"),
         max.get("frames_dropped"),
         max.get("dropped_stale"),
         max.get("dropped_send_buffer") + max.get("send_errors"),
