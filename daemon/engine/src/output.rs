@@ -120,6 +120,12 @@ pub trait Sink {
 
     /// One processed frame. Must not block: what cannot be sent now is dropped and counted.
     fn handle_frame(&mut self, frame: &Processed<'_>);
+
+    /// Streams that are gone (their source went quiet and the engine forgot them,
+    /// [`crate::Pipeline::forget_quiet_streams`]): a sink that announces its streams to its
+    /// clients (a NatNet or QTM server's model definitions) tells them. A stream that is made
+    /// again, or relabelled, shows in its next frame (the same id, other labels or model).
+    fn handle_gone(&mut self, _gone: &[StreamKey]) {}
 }
 
 /// Frames dropped on the floor: a pipeline with no output (tests, warm-up).

@@ -230,6 +230,7 @@ impl Processing {
             self.last_sweep = Instant::now();
             let gone = self.pipeline.forget_quiet_streams();
             if !gone.is_empty() {
+                self.outputs.handle_gone(&gone);
                 let mut list: Vec<String> = gone
                     .iter()
                     .take(8)

@@ -16,7 +16,7 @@
 pub mod osc;
 pub mod recording;
 
-use engine::{Needs, Processed, Sink};
+use engine::{Needs, Processed, Sink, StreamKey};
 
 use self::osc::OscOutput;
 use self::recording::Recorder;
@@ -53,6 +53,14 @@ impl Sink for Outputs {
         self.recorder.handle_frame(frame);
         for sink in &mut self.others {
             sink.handle_frame(frame);
+        }
+    }
+
+    fn handle_gone(&mut self, gone: &[StreamKey]) {
+        self.osc.handle_gone(gone);
+        self.recorder.handle_gone(gone);
+        for sink in &mut self.others {
+            sink.handle_gone(gone);
         }
     }
 }
