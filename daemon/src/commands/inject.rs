@@ -24,16 +24,7 @@ pub(crate) fn run(args: &InjectArgs) -> Result<()> {
         .map(Regions::load)
         .transpose()
         .map_err(anyhow::Error::from)?;
-    let takes = args
-        .files
-        .iter()
-        .map(|path| {
-            Ok(LoadedTake {
-                path: path.clone(),
-                take: offline::load_take(path)?,
-            })
-        })
-        .collect::<Result<Vec<LoadedTake>>>()?;
+    let takes = load_takes(args)?;
     let head = head_reference(args, regions.as_ref(), &takes)?;
     let params = InjectParams {
         seed: args.seed,
@@ -56,6 +47,29 @@ pub(crate) fn run(args: &InjectArgs) -> Result<()> {
         std::fs::write(&path, regions.to_toml()?)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
+    print_written(args, &session, &head, &manifest)
+}
+
+/// The captures named on the command line, read.
+fn load_takes(args: &InjectArgs) -> Result<Vec<LoadedTake>> {
+    args.files
+        .iter()
+        .map(|path| {
+            Ok(LoadedTake {
+                path: path.clone(),
+                take: offline::load_take(path)?,
+            })
+        })
+        .collect()
+}
+
+/// What `inject` wrote and where, as it prints it.
+fn print_written(
+    args: &InjectArgs,
+    session: &InjectedSession,
+    head: &[String],
+    manifest: &std::path::Path,
+) -> Result<()> {
     let sentences = session.cuts().len() / args.levels;
     crate::out!(
         "wrote {} takes: {sentences} sentences x {} levels ({}) of a {} mm field to {}",

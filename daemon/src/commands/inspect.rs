@@ -33,6 +33,21 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
         r.algorithm,
         r.best_restart
     );
+    print_emotion(&model)?;
+    crate::out!("roles:");
+    for (k, role) in model.roles().iter().enumerate() {
+        let norm = model.mixing().column(k).norm();
+        crate::out!("  c{k}: {role:?} (mixing norm {norm:.3} mm)");
+    }
+    if model.quality().is_empty() {
+        crate::out!("quality:    not recorded (trained before quality reports)");
+        return Ok(());
+    }
+    print_quality(model.quality())
+}
+
+/// The model's emotion space: its axes or components and each emotion's point.
+fn print_emotion(model: &ica_core::model::IcaModel) -> Result<()> {
     let emotion = model.emotion();
     let space = emotion.space_components();
     let list: Vec<String> = space.iter().map(|c| format!("c{c}")).collect();
@@ -63,16 +78,7 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     if let Some(c) = &emotion.conditioning {
         crate::out!("  conditioning: {}", c.note);
     }
-    crate::out!("roles:");
-    for (k, role) in model.roles().iter().enumerate() {
-        let norm = model.mixing().column(k).norm();
-        crate::out!("  c{k}: {role:?} (mixing norm {norm:.3} mm)");
-    }
-    if model.quality().is_empty() {
-        crate::out!("quality:    not recorded (trained before quality reports)");
-        return Ok(());
-    }
-    print_quality(model.quality())
+    Ok(())
 }
 
 /// An emotion's point: its level on the one axis, or `c0 0.1234, c2 -0.5678` over several
