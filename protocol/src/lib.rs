@@ -8,38 +8,9 @@
 //! # Address space
 //!
 //! Big-endian, 4-byte aligned OSC 1.0 over UDP. `i` int32, `h` int64, `f` float32, `s` string,
-//! `b` blob.
-//!
-//! | Address | Tags | Direction | Meaning |
-//! |---|---|---|---|
-//! | `/mocap/frame` | `,ihbb` | source → daemon, daemon → compact clients | frame number; capture time µs (sender's clock); missing-marker bitmask (marker i = bit i mod 8, LSB first, of byte i div 8); positions, markers × 3 f32 mm, x y z |
-//! | `/mocap/frame` | `,ih` + 3n × `f` | source → daemon | flat form, a marker with all three NaN is missing |
-//! | `/mocap/labels` | `,i` + n × `s` | source → daemon, at start and every second | layout id, marker names in frame order |
-//! | `/mocap/timecode` | `,iiiii` | source → daemon, daemon → compact and components clients, in the frame's bundle | SMPTE timecode packed `hh<<24\|mm<<16\|ss<<8\|ff`, subframe, rate numerator, rate denominator (0/1 unknown), flags (bit 0 timecode present, bit 1 drop-frame, bit 2 capture time is UTC µs); see [`decode_timecode`] |
-//! | `/emoshift/state` | `,sf` | daemon → compact | target emotion, current amount (after the frame, same bundle) |
-//! | `/mocap/part` | `,iiii` + 3k × `f` | daemon → flat-split | frame number, first marker, k markers here, markers in frame, then x y z per marker (NaN = missing); each ≤ 1,472 bytes |
-//! | `/emoshift/components` | n × `f` | daemon → components | current u |
-//! | `/VMC/Ext/Blend/Val` | `,sf` | daemon → components | one per labelled component: name, value |
-//! | `/VMC/Ext/Blend/Apply` | `,` | daemon → components | closes the VMC values of one frame |
-//! | `/emotion/target` | `,s` | control | target emotion |
-//! | `/emotion/amount` | `,f` | control | edit amount (finite) |
-//! | `/emotion/ramp` | `,f` | control | ramp time, seconds ≥ 0 |
-//! | `/emotion/mix` | `,sf` + more `sf` | control | move towards a blend: (emotion name, weight ≥ 0) pairs, normalised to sum 1 |
-//! | `/emotion/list` | `,` | control | answered with `/emotion/list/confirm`: `i` k, k × `i` emotion components, then per emotion `s` name and k × `f` levels |
-//! | `/emotion/alpha` | `,if` | control | raw translate of component i |
-//! | `/component/gain` | `,if` | control | gain of component i |
-//! | `/bypass` | `,i` | control | non-zero: pass frames through unedited |
-//! | `/subscribe` | `,is` | control | port on the sender's host, profile (`compact`, `flat-split`, `components`) |
-//! | `/unsubscribe` | `,i` | control | port on the sender's host |
-//! | `/model/load` | `,s` | control | model path |
-//! | `/record/start` | `,s` / `,ss` | control | recording path (and the raw input's) |
-//! | `/record/stop` | `,` | control | |
-//! | `/status` | `,` | control | asks for the counters |
-//! | `<control>/confirm` | as the control | reply | accepted; echoes the arguments in canonical types |
-//! | `/status/confirm` | (`s` `h`)* | reply | counters as name, int64 value pairs, in the daemon's order |
-//! | `/emoshift/error` | `,ss` | reply | address of the refused message, why |
-//!
-//! Float control arguments also accept `i` and `d`; `/bypass` also accepts `T`/`F`.
+//! `b` blob. Every address is a constant in [`address`]; what each one carries, who sends it
+//! and the control limits are in the workspace's one address table, `docs/osc.md` (a test,
+//! `docs_osc`, fails when an address defined here is missing from it).
 //!
 //! # Decisions
 //!
@@ -48,9 +19,9 @@
 //!   frame's ([`LayoutBook`]). A source may send layouts of different sizes; same-size layouts
 //!   replace each other, so a source with two same-size layouts must use two ports. Frames with
 //!   no matching layout are counted and dropped by the daemon until the labels arrive.
-//! - **Compact profile.** One bundle, time tag "immediately": the `,ihbb` frame then
-//!   `/emoshift/state ,sf`. Atomic in one datagram (1,424 bytes for 109 markers and the target
-//!   `neutral`); fits 1,472 bytes for target names up to 55 bytes.
+//! - **Compact profile.** One bundle, time tag "immediately": `/emoshift/stream ,is`, the
+//!   `,ihbb` frame, `/emoshift/state ,sf` and the source's `/mocap/timecode`. Atomic in one
+//!   datagram ([`encode_compact_into`]: 1,464 bytes for 109 markers without the timecode).
 //! - **Components profile.** Without VMC labels, the bare `/emoshift/components` message;
 //!   with labels, one bundle: components, the `Val`s, then `Apply`.
 //! - **Flat-split.** Parts carry the frame's marker count so a receiver knows when it has all.

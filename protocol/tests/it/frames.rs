@@ -188,6 +188,16 @@ fn a_109_marker_compact_bundle_fits_one_ethernet_payload() {
     };
     let n = protocol::encode_compact_into(&tag, &f, "neutral", 0.5, &mut out).expect("valid");
     assert_eq!(n, 1_464);
+    let utc = protocol::FrameTime {
+        timecode: None,
+        clock: protocol::CaptureClock::Utc,
+    };
+    protocol::append_timecode_element(&utc, &mut out);
+    assert_eq!(
+        out.len(),
+        1_512,
+        "with /mocap/timecode, as docs/osc.md says"
+    );
     let long = "x".repeat(15);
     let n = protocol::encode_compact_into(&tag, &f, &long, 0.5, &mut out).expect("valid");
     assert_eq!(n, protocol::ETHERNET_PAYLOAD);

@@ -7,6 +7,7 @@
 
 mod alloc;
 mod control;
+mod docs_osc;
 mod frames;
 mod natnet_alloc;
 mod natnet_capture;
