@@ -9,6 +9,7 @@ use anyhow::{Context, Result};
 use ica_core::model::IcaModel;
 use tokio_util::sync::CancellationToken;
 
+use crate::serve::config::{ConfigError, RawConfig};
 use crate::serve::{self, Config};
 
 /// A running daemon and its bound addresses.
@@ -82,6 +83,22 @@ impl Drop for Daemon {
     fn drop(&mut self) {
         self.shutdown.cancel();
     }
+}
+
+/// The config of a daemon on ephemeral loopback ports (`--listen 127.0.0.1:0 --control
+/// 127.0.0.1:0`) for [`Daemon::start_with`], with the monitor page at `monitor` when given.
+///
+/// # Errors
+/// A `monitor` address that is not `IP:PORT`.
+pub fn loopback_config(monitor: Option<&str>) -> Result<Config, ConfigError> {
+    RawConfig {
+        listen: Some("127.0.0.1:0".into()),
+        control: Some("127.0.0.1:0".into()),
+        model: Some("model.json".into()),
+        monitor: monitor.map(str::to_string),
+        ..Default::default()
+    }
+    .validate()
 }
 
 type Bound = Result<(SocketAddr, SocketAddr, Option<SocketAddr>)>;

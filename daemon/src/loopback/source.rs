@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use protocol::{encode_frame_flat_into, encode_frame_into, encode_labels_into, FrameBuf, Labels};
-use replay::pacer::{Action, FrameSend, Pacer};
+use replay::pacer::{Action, FrameSend, Pacer, PacerOptions};
 use replay::Take;
 
 /// How long before a deadline a take's sender stops sleeping and spins.
@@ -57,6 +57,39 @@ pub fn drive(
         }
     }
     Ok(())
+}
+
+/// Replays `take` from a loopback socket to `to` at its rate, looping, until `stop` is raised
+/// or, with `limit`, that many frames are out; `sending` hears each frame's number just before
+/// it goes. Returns how many frames the pacer sent late.
+///
+/// # Errors
+/// No socket, a take the pacer refuses, a failed send.
+pub fn play_take(
+    take: &Take,
+    to: SocketAddr,
+    limit: Option<usize>,
+    stop: &AtomicBool,
+    mut sending: impl FnMut(i64),
+) -> Result<u64> {
+    let socket = UdpSocket::bind("127.0.0.1:0").context("cannot open a udp socket")?;
+    let mut source = Source::new(&take_labels(take, 0), socket, to, false)?;
+    let options = PacerOptions {
+        first_frame_number: take.first_frame,
+        looping: true,
+        ..PacerOptions::default()
+    };
+    let mut pacer = Pacer::new(take.rate_hz, take.n_frames(), options)?;
+    drive(&mut pacer, SPIN, stop, |due| {
+        if let Due::Frame(f) = due {
+            if limit.is_some_and(|n| f.stream_index as usize >= n) {
+                return Ok(false);
+            }
+            sending(f.frame_number);
+        }
+        source.send_due(take, due).map(|()| true)
+    })?;
+    Ok(pacer.summary().late_frames)
 }
 
 /// Sleeps until `spin` before `deadline`, then spins; returns early on a stop request.

@@ -10,10 +10,10 @@
 //!    their roles, and the path of the HTML report.
 //!
 //! With `--monitor [IP:PORT]`, steps 4 to 6 become: the daemon with the monitor page served,
-//! the take looping until Ctrl-C (`monitor`).
+//! the take looping until Ctrl-C. Everything live goes through the loopback harness
+//! ([`crate::loopback`]); training and analysis are `train`'s and `analyze`'s own functions.
 
 mod live;
-mod monitor;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -32,6 +32,8 @@ use crate::offline::training::TrainOptions;
 /// replay/tests/fixtures/SOURCE.md) and the regions read off its geometry.
 const FACIAL_SING: &[u8] = include_bytes!("../../../../replay/tests/fixtures/Facial-Sing.c3d");
 const FACIAL_SING_REGIONS: &str = include_str!("../../../tests/fixtures/facial-sing.regions.toml");
+const FACIAL_SING_MANIFEST: &str =
+    "rate_hz = 100\n\n[[take]]\nfile = \"Facial-Sing.c3d\"\nsentence = \"song\"\nemotion = \"singing\"\n";
 
 /// Sentences of the demo session: 8 x 4 emotions over 2 emotion directions, about 13,000
 /// frames at 120 Hz.
@@ -46,25 +48,18 @@ fn step(n: usize, text: &str) -> Result<()> {
 
 pub(crate) fn run(args: &DemoArgs) -> Result<()> {
     let started = Instant::now();
-    let (dir, temporary) = match &args.keep {
-        Some(d) => {
-            crate::offline::output::check_out_dir(d, false)?;
-            (d.clone(), false)
-        }
-        None => (fresh_temp_dir()?, true),
-    };
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let result = chain(args, &dir, started);
-    if temporary {
+    let Some(dir) = &args.keep else {
+        let dir = tempfile::Builder::new()
+            .prefix("emoshift-demo-")
+            .tempdir()
+            .context("cannot create a temporary folder")?
+            .keep();
+        let result = chain(args, &dir, started);
         // Only the report stays, so the path in the summary opens; the rest was scaffolding.
         for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
             if entry.file_name() != "report" {
                 let path = entry.path();
-                let _ = if path.is_dir() {
-                    std::fs::remove_dir_all(&path)
-                } else {
-                    std::fs::remove_file(&path)
-                };
+                let _ = std::fs::remove_dir_all(&path).or_else(|_| std::fs::remove_file(&path));
             }
         }
         if result.is_ok() {
@@ -72,30 +67,19 @@ pub(crate) fn run(args: &DemoArgs) -> Result<()> {
                 "(session and model were temporary; `emoshift demo --keep DIR` keeps them)"
             );
         }
-    }
-    result
+        return result;
+    };
+    crate::offline::output::check_out_dir(dir, false)?;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    chain(args, dir, started)
 }
 
-/// A new folder under the system's temporary folder, never one that was there before.
-fn fresh_temp_dir() -> Result<PathBuf> {
-    let base = std::env::temp_dir();
-    for k in 0..100 {
-        let dir = base.join(format!("emoshift-demo-{}-{k}", std::process::id()));
-        match std::fs::create_dir(&dir) {
-            Ok(()) => return Ok(dir),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(e).with_context(|| format!("cannot create {}", dir.display())),
-        }
-    }
-    anyhow::bail!("no free folder name under {}", base.display())
-}
-
-/// The inputs of training and analysis, and the take to stream.
+/// The inputs of training and analysis, the take to stream, and the emotions to sweep
+/// through while streaming (none without emotion pairs).
 struct Session {
     manifest: PathBuf,
     regions: Option<PathBuf>,
     take: PathBuf,
-    /// Emotions to sweep through while streaming (none without emotion pairs).
     sweep: Vec<String>,
 }
 
@@ -107,10 +91,7 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
         )?;
         real_session(dir)?
     } else {
-        step(
-            1,
-            "a paired synthetic session (8 sentences x neutral, happy, sad, angry over 2 emotion directions)",
-        )?;
+        step(1, "a paired synthetic session (8 sentences x neutral, happy, sad, angry over 2 emotion directions)")?;
         synthetic_session(dir, args.seed)?
     };
     step(2, "training the ICA model")?;
@@ -135,7 +116,7 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
             4,
             "serving on loopback with the monitor page, the take looping",
         )?;
-        return monitor::serve(&model, take, addr);
+        return live::serve_with_monitor(&model, take, addr);
     }
     step(4, "serving on loopback and replaying a take through it")?;
     let live = live::stream(&model, take, &session.sweep)?;
@@ -148,19 +129,17 @@ fn synthetic_session(dir: &Path, seed: u64) -> Result<Session> {
         seed,
         sentences: SENTENCES,
         emotions: ["neutral", "happy", "sad", "angry"]
-            .iter()
-            .map(|e| e.to_string())
-            .collect(),
+            .map(String::from)
+            .to_vec(),
         emotion_dims: 2,
         ..SynthParams::default()
     };
     let s = dir.join("session");
     let summary = write_session(&s, &params, replay::Format::C3d)
         .with_context(|| format!("cannot write the session to {}", s.display()))?;
+    let (takes, frames) = (summary.takes.len(), summary.total_frames);
     crate::out!(
-        "wrote {} takes, {} frames, {} markers to {}",
-        summary.takes.len(),
-        summary.total_frames,
+        "wrote {takes} takes, {frames} frames, {} markers to {}",
         summary.markers,
         s.display()
     );
@@ -168,21 +147,23 @@ fn synthetic_session(dir: &Path, seed: u64) -> Result<Session> {
         manifest: summary.manifest,
         regions: None,
         take: s.join("s01_neutral.c3d"),
-        sweep: vec!["sad".into(), "happy".into(), "angry".into()],
+        sweep: ["sad", "happy", "angry"].map(String::from).to_vec(),
     })
 }
 
 fn real_session(dir: &Path) -> Result<Session> {
-    let take = dir.join("Facial-Sing.c3d");
-    std::fs::write(&take, FACIAL_SING)
-        .with_context(|| format!("cannot write {}", take.display()))?;
-    let regions = dir.join("regions.toml");
-    std::fs::write(&regions, FACIAL_SING_REGIONS)?;
-    let manifest = dir.join("session.toml");
-    std::fs::write(
-        &manifest,
-        "rate_hz = 100\n\n[[take]]\nfile = \"Facial-Sing.c3d\"\nsentence = \"song\"\nemotion = \"singing\"\n",
-    )?;
+    let (take, regions, manifest) = (
+        dir.join("Facial-Sing.c3d"),
+        dir.join("regions.toml"),
+        dir.join("session.toml"),
+    );
+    for (path, bytes) in [
+        (&take, FACIAL_SING),
+        (&regions, FACIAL_SING_REGIONS.as_bytes()),
+        (&manifest, FACIAL_SING_MANIFEST.as_bytes()),
+    ] {
+        std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
+    }
     crate::out!(
         "wrote {}, its regions and a one-take manifest (no emotion pairs)",
         take.display()
