@@ -16,7 +16,12 @@
 //!   contain underscores (each column splits at its last `_`) and spaces; header cells are trimmed
 //!   and may be double-quoted. Labels cannot contain commas.
 //! - Every data row has exactly the header's column count ([`ReadError::ColumnCount`]); blank
-//!   lines and CRLF are tolerated. An empty or `NaN` cell means missing, and a marker is missing in
+//!   lines and CRLF are tolerated.
+//! - A last line without its newline is a row cut off mid-write (a recording killed, a power
+//!   cut): the take ends before it, whatever it holds, since a row cut inside its last number
+//!   would otherwise read as a wrong value. emoshift writes every row whole, newline included;
+//!   a file of another program that lacks its final newline loses its last row here, and
+//!   [`crate::repair::inspect`] (`emoshift info`) says so. An empty or `NaN` cell means missing, and a marker is missing in
 //!   a frame if any of its three cells is; `inf` or text is [`ReadError::BadCell`].
 //! - The first row's `frame` is the take's first frame; later rows must count up by one
 //!   ([`ReadError::FrameGap`]).

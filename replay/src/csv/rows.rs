@@ -119,7 +119,9 @@ impl<R: BufRead> NextRow for CsvRows<R> {
         if self.done {
             return Ok(None);
         }
-        let Some((line, row)) = self.lines.next_non_blank()? else {
+        // A last row without its newline was cut off mid-write: the take ends cleanly before
+        // it (see the module docs).
+        let Some((line, row)) = self.lines.next_whole()? else {
             self.done = true;
             return Ok(None);
         };

@@ -26,15 +26,17 @@
 //! - The first row's `Frame#` is the take's first frame; later rows must count up by one
 //!   ([`ReadError::FrameGap`]). The `Time` column must be a number but is otherwise not used: the
 //!   rate is `DataRate`.
-//! - `NumMarkers` must equal the names listed ([`ReadError::MarkerCountMismatch`]) and `NumFrames`
-//!   the data rows ([`ReadError::FrameCountMismatch`]). Neither side wins: fewer rows usually means
-//!   a truncated file, and accepting it would silently lose frames; more rows means the header
-//!   is wrong in a way that makes the rest doubtful too.
+//! - `NumMarkers` must equal the names listed ([`ReadError::MarkerCountMismatch`]). `NumFrames`
+//!   rows are read: fewer is [`ReadError::FrameCountMismatch`] (a truncated file: accepting it
+//!   would silently lose frames); rows past it are not read, as a C3D reader keeps to its
+//!   header's range. Those are a recording's last frames, written after its header was last
+//!   updated: [`crate::repair`] tells and counts them (`emoshift info` warns, `emoshift repair`
+//!   fixes the header).
 //!
 //! Writing always uses millimetres, the shortest decimal text that reads back to the same `f32`
 //! (round trips are exact), times to the microsecond, and empty cells for missing samples.
 
-mod header;
+pub(crate) mod header;
 pub(crate) mod row_blocks;
 mod rows;
 pub(crate) mod text;

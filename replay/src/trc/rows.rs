@@ -85,10 +85,16 @@ impl<R: BufRead> NextRow for TrcRows<R> {
         if self.done {
             return Ok(None);
         }
+        if rows == self.declared {
+            // The header wins: rows past `NumFrames` are a recording's frames written after its
+            // header was last updated (`emoshift repair` counts them), or junk.
+            self.done = true;
+            return Ok(None);
+        }
         // The row is copied out because `lines` stays borrowed while its text is.
         let Some((line, text)) = self.lines.next_non_blank()? else {
             self.done = true;
-            if rows != self.declared {
+            if rows < self.declared {
                 let (declared, found) = (self.declared, rows);
                 return Err(ReadError::FrameCountMismatch { declared, found });
             }

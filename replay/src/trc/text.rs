@@ -87,6 +87,18 @@ impl<R: BufRead> Lines<R> {
     }
 }
 
+impl<R: BufRead> Lines<R> {
+    /// The next non-blank line ended by a newline; `None` at the end of input, and at a last
+    /// line without one (a row cut off mid-write).
+    ///
+    /// # Errors
+    /// As [`Lines::next_line`].
+    pub(crate) fn next_whole(&mut self) -> Result<Option<(usize, &str)>, ReadError> {
+        let found = self.next_non_blank()?.is_some();
+        Ok((found && self.terminated).then_some((self.number, &self.text)))
+    }
+}
+
 /// What a sample cell may hold.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Sample {

@@ -106,8 +106,7 @@ fn truncated_files_are_errors_in_blocks_too() {
     let take = synthetic(5, 30, 1);
     for format in FORMATS {
         let bytes = bytes_of(format, &take);
-        // Cut inside the data: mid-frame for C3D, a few cells into a row for the text formats
-        // (a cut inside a CSV row's last cell would leave a shorter number: a valid file).
+        // Cut inside the data: mid-frame for C3D, a few cells into a row for the text formats.
         let at = match format {
             Format::C3d => bytes.len() - 700,
             _ => {
@@ -120,6 +119,15 @@ fn truncated_files_are_errors_in_blocks_too() {
             }
         };
         let cut = &bytes[..at];
+        if format == Format::Csv {
+            // CSV has no count: a row cut off mid-write ends the take cleanly (issue 36).
+            let rows = whole(format, cut).expect("the rows before the cut");
+            assert!(rows.n_frames() > 0 && rows.n_frames() < take.n_frames());
+            for size in [1, 7, 1000] {
+                assert_eq!(in_blocks(format, cut, size).expect("blocks"), rows);
+            }
+            continue;
+        }
         let expected = whole(format, cut).expect_err("a truncated file");
         for size in [1, 7, 1000] {
             let e = in_blocks(format, cut, size).expect_err("a truncated file");
@@ -127,7 +135,6 @@ fn truncated_files_are_errors_in_blocks_too() {
                 (format, &e),
                 (Format::C3d, ReadError::C3d(C3dError::Truncated { .. }))
                     | (Format::Trc, ReadError::TruncatedRow { .. })
-                    | (Format::Csv, ReadError::ColumnCount { .. })
             );
             assert!(typed, "{format:?}: {e}");
             assert_eq!(e.to_string(), expected.to_string(), "{format:?}");
