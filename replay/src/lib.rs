@@ -17,6 +17,7 @@ pub mod file;
 pub mod format;
 pub mod pacer;
 pub mod recorder;
+pub mod repair;
 mod resample;
 pub mod session;
 pub mod synth;

@@ -52,6 +52,28 @@ impl Processor {
     }
 }
 
+impl Processor {
+    /// Writes a 16-bit word (the bit pattern of `v`, signed or not) in this byte order.
+    pub fn put_u16(self, v: u16) -> [u8; 2] {
+        match self {
+            Processor::Intel | Processor::Dec => v.to_le_bytes(),
+            Processor::Mips => v.to_be_bytes(),
+        }
+    }
+
+    /// Writes a 32-bit float in this format (the inverse of [`Processor::f32`]).
+    pub fn put_f32(self, v: f32) -> [u8; 4] {
+        match self {
+            Processor::Intel => v.to_le_bytes(),
+            Processor::Mips => v.to_be_bytes(),
+            Processor::Dec => {
+                let b = (v * 4.0).to_le_bytes();
+                [b[2], b[3], b[0], b[1]]
+            }
+        }
+    }
+}
+
 /// Reads two bytes at `at`, if present.
 pub fn take2(bytes: &[u8], at: usize) -> Option<[u8; 2]> {
     bytes.get(at..at.checked_add(2)?)?.try_into().ok()

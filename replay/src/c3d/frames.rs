@@ -30,6 +30,45 @@ pub struct C3dBlocks<R> {
     next: usize,
 }
 
+/// The start of a C3D file: its bytes through the parameter section, and what they say.
+pub(crate) struct Head {
+    /// The bytes read: the header, the parameter section, at times a little more.
+    pub(crate) prefix: Vec<u8>,
+    pub(crate) processor: binary::Processor,
+    pub(crate) header: binary::Header,
+    pub(crate) params: params::Params,
+}
+
+/// Reads the header and the parameter section (at most the 255 parameter blocks a header can
+/// point at, or up to the data start), leaving `input` after them.
+///
+/// # Errors
+/// As [`super::read`], for the header and parameters.
+pub(crate) fn read_head(input: &mut impl Read) -> Result<Head, ReadError> {
+    let mut prefix = Vec::with_capacity(BLOCK);
+    fill_to(input, &mut prefix, BLOCK)?;
+    if prefix.len() < BLOCK {
+        return Err(C3dError::TooShort { len: prefix.len() }.into());
+    }
+    let parameter_block = usize::from(prefix[0]);
+    fill_to(input, &mut prefix, parameter_block.max(1) * BLOCK)?;
+    let (processor, header) = binary::parse_header(&prefix)?;
+    let start = (parameter_block - 1) * BLOCK;
+    let end = if header.data_block > parameter_block {
+        (header.data_block - 1) * BLOCK
+    } else {
+        start + usize::from(prefix[start + 2]).max(1) * BLOCK
+    };
+    fill_to(input, &mut prefix, end)?;
+    let params = params::parse(&prefix, parameter_block, header.data_block, processor)?;
+    Ok(Head {
+        prefix,
+        processor,
+        header,
+        params,
+    })
+}
+
 /// Reads until `buf` holds `len` bytes or the input ends.
 fn fill_to(input: &mut impl Read, buf: &mut Vec<u8>, len: usize) -> Result<(), ReadError> {
     if buf.len() < len {
@@ -47,22 +86,12 @@ impl<R: BufRead> C3dBlocks<R> {
     /// As [`super::read`] for the header and parameters; [`C3dError::Truncated`] when
     /// `file_len` cannot hold the declared frames.
     pub fn new(mut input: R, file_len: Option<u64>) -> Result<Self, ReadError> {
-        let mut prefix = Vec::with_capacity(BLOCK);
-        fill_to(&mut input, &mut prefix, BLOCK)?;
-        if prefix.len() < BLOCK {
-            return Err(C3dError::TooShort { len: prefix.len() }.into());
-        }
-        let parameter_block = usize::from(prefix[0]);
-        fill_to(&mut input, &mut prefix, parameter_block.max(1) * BLOCK)?;
-        let (processor, h) = binary::parse_header(&prefix)?;
-        let start = (parameter_block - 1) * BLOCK;
-        let end = if h.data_block > parameter_block {
-            (h.data_block - 1) * BLOCK
-        } else {
-            start + usize::from(prefix[start + 2]).max(1) * BLOCK
-        };
-        fill_to(&mut input, &mut prefix, end)?;
-        let params = params::parse(&prefix, parameter_block, h.data_block, processor)?;
+        let Head {
+            mut prefix,
+            processor,
+            header: h,
+            params,
+        } = read_head(&mut input)?;
         let len = file_len.map_or(usize::MAX, |l| usize::try_from(l).unwrap_or(usize::MAX));
         let layout = Layout::new(processor, &h, &params, len)?;
         if layout.data_offset > prefix.len() {

@@ -13,6 +13,7 @@
 
 mod binary;
 mod decode;
+pub(crate) mod extent;
 mod frames;
 mod layout;
 mod params;

@@ -28,6 +28,8 @@ pub struct Param {
     pub dims: Vec<usize>,
     /// The data.
     pub value: Value,
+    /// Absolute byte offset of the data in the file, where a repair patches a count in place.
+    pub offset: usize,
 }
 
 /// All parameters of a file, in file order.
@@ -121,13 +123,14 @@ pub fn parse(
     {
         match entry.kind {
             Kind::Group => groups.push((entry.id.saturating_abs(), entry.name)),
-            Kind::Param(dims, value) => raw.push((
+            Kind::Param(dims, value, data_at) => raw.push((
                 entry.id,
                 Param {
                     group: String::new(),
                     name: entry.name,
                     dims,
                     value,
+                    offset: start + data_at,
                 },
             )),
         }
@@ -151,7 +154,8 @@ pub fn parse(
 
 enum Kind {
     Group,
-    Param(Vec<usize>, Value),
+    /// Dimensions, value and the data's offset in the section.
+    Param(Vec<usize>, Value, usize),
 }
 
 struct Entry {
@@ -185,8 +189,8 @@ impl Entry {
         let kind = if id < 0 {
             Kind::Group
         } else {
-            let (dims, value) = parse_value(s, name_end + 2, p)?;
-            Kind::Param(dims, value)
+            let (dims, value, data_at) = parse_value(s, name_end + 2, p)?;
+            Kind::Param(dims, value, data_at)
         };
         Ok(Some(Entry {
             id,
@@ -197,7 +201,12 @@ impl Entry {
     }
 }
 
-fn parse_value(s: &[u8], at: usize, p: Processor) -> Result<(Vec<usize>, Value), &'static str> {
+/// A parameter's dimensions, value and where its data starts in `s`.
+fn parse_value(
+    s: &[u8],
+    at: usize,
+    p: Processor,
+) -> Result<(Vec<usize>, Value, usize), &'static str> {
     let ty = *s.get(at).ok_or("type runs past the end")? as i8;
     let ndims = usize::from(*s.get(at + 1).ok_or("dimensions run past the end")?);
     let dims: Vec<usize> = s
@@ -234,5 +243,5 @@ fn parse_value(s: &[u8], at: usize, p: Processor) -> Result<(Vec<usize>, Value),
                 .collect(),
         ),
     };
-    Ok((dims, value))
+    Ok((dims, value, data_at))
 }

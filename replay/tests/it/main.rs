@@ -9,6 +9,7 @@ mod c3d;
 mod c3d_samples;
 mod pacer;
 mod recorder;
+mod repair;
 mod synth;
 mod synth_pins;
 mod synth_space;
