@@ -12,6 +12,7 @@
 pub mod blocks;
 pub mod c3d;
 pub mod csv;
+mod durable;
 pub mod error;
 pub mod file;
 pub mod format;

@@ -9,7 +9,7 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use crate::error::{TakeError, WriteError};
-use crate::recorder::Recorder;
+use crate::recorder::{Behind, Recorder};
 use crate::{c3d, csv, trc, Format, Take};
 
 /// Write buffer of the exact writer: large writes, few system calls.
@@ -57,7 +57,9 @@ impl TakeWriter {
             (Some(n), _) => (n, format),
             (None, Format::Csv) => (0, format),
             (None, _) => {
-                let rec = Recorder::create(path, labels.to_vec(), rate_hz, first_frame)?;
+                // Offline: frames can wait for the disk rather than stop the file.
+                let rec = Recorder::create(path, labels.to_vec(), rate_hz, first_frame)?
+                    .when_behind(Behind::Wait);
                 return Ok(TakeWriter(Inner::Recorder(rec)));
             }
         };

@@ -215,6 +215,17 @@ pub enum WriteError {
     /// The take breaks an invariant.
     #[error(transparent)]
     Invalid(#[from] TakeError),
+    /// A recording stopped before it was finished, by a write error (a full disk) or a disk
+    /// that fell too far behind: the file is closed valid with the frames that fit, its header
+    /// counting them. The message names the cause (the OS's own words: "No space left on
+    /// device").
+    #[error("stopped after {frames} frames, which the file keeps: {cause}")]
+    Stopped {
+        /// Frames the file keeps.
+        frames: u64,
+        /// What stopped it.
+        cause: std::io::Error,
+    },
     /// A take written in blocks ended with another frame count than its header declared.
     #[error("header declares {declared} frames but {written} were written")]
     FrameCountMismatch {

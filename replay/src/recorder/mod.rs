@@ -17,13 +17,30 @@
 //! The file holds exactly what [`crate::save`] writes for the same take, byte for byte in the
 //! data; only the headers differ where a count is not known until the end:
 //! - **TRC**: `NumFrames` and `OrigNumFrames` are written as a blank-padded placeholder and
-//!   patched in place by [`Recorder::finish`] (readers trim the field).
+//!   patched in place as frames reach the disk, and on finish (readers trim the field).
 //! - **C3D**: the parameter section is sized for a take longer than 65,535 frames (room for
-//!   POINT:LONG_FRAMES) and rewritten in place, with the header, on finish.
+//!   POINT:LONG_FRAMES) and rewritten in place, with the header, as frames reach the disk (only
+//!   the bytes that change) and on finish.
 //! - **CSV** has no count; rows are complete as they are written.
 //!
-//! Only one frame's bytes are held, in a reused buffer behind a [`BufWriter`]: memory does not
-//! grow with the take, and [`Recorder::push_frame`] does not allocate once warm.
+//! **Crash-safe.** The file is written on its own thread: [`Recorder::push_frame`] encodes the
+//! frame and copies it to that thread's buffer, and never waits on the disk. That thread writes
+//! what arrived every 0.2 s, and every 0.4 s makes it durable (`fdatasync`) and then updates the
+//! header's count (C3D's frame range, TRC's `NumFrames`) to the frames on disk. After SIGKILL a
+//! reader sees every frame but those of the last half second; after a power cut, every frame
+//! but those of the last second (with a disk that syncs within a tenth of a second). Frames
+//! written after the last count are there for [`crate::repair`] (`emoshift repair`). A CSV row
+//! is written whole with its newline, and a last row without one reads as the end of the take.
+//! Only [`Recorder::create`] (the file created and its header written) touches the disk on the
+//! caller's thread.
+//!
+//! **Write errors** (a full disk): the file is closed valid with the whole frames that fit
+//! (the header counting them), and every later push returns [`WriteError::Stopped`] naming the
+//! cause and the frames kept. A disk that falls 64 MiB behind stops the recording the same way
+//! (or, with [`Behind::Wait`], makes the caller wait), so memory stays bounded.
+//!
+//! Memory does not grow with the take, and [`Recorder::push_frame`] does not allocate once the
+//! buffers shared with the file's thread have grown to a flush's worth of frames.
 //!
 //! **Zero frames.** TRC and CSV recordings of no frames are valid files that load as a take with
 //! no frames (a CSV cannot store the first frame number without rows: it reads back as 1). C3D
@@ -36,21 +53,21 @@
 
 use std::fmt::Write as _;
 use std::fs::File;
-use std::io::{BufWriter, Seek, SeekFrom, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::c3d::write::{self as c3d, FrameRange, Meta};
 use crate::c3d::C3dLimitError;
+use crate::durable::{C3dCount, CsvRows, DurableFile, Header, Stopped, TrcCount};
 use crate::error::{TakeError, WriteError};
 pub use crate::take::RecordTime;
 use crate::trc::text::{check_labels, push_sample};
 use crate::{Format, Take};
 
-mod trc_header;
-use trc_header::{trc_header, COUNT_WIDTH, RATE_WIDTH};
+pub use crate::durable::{Behind, FLUSH, SYNC};
 
-/// Write buffer: a few frames of a large layout, so the kernel sees few, large writes.
-const BUFFER_BYTES: usize = 64 * 1024;
+pub(crate) mod trc_header;
+use trc_header::{trc_header, COUNT_WIDTH, RATE_WIDTH};
 
 /// What a finished recording holds.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,20 +87,14 @@ pub struct RecordSummary {
 pub struct Recorder {
     path: PathBuf,
     format: Format,
-    /// `None` once finished.
-    out: Option<BufWriter<File>>,
+    /// The file, written on its own thread; `None` once finished.
+    out: Option<DurableFile>,
     labels: Vec<String>,
     rate_hz: f64,
     first_frame: i64,
     frames: u64,
-    /// TRC: byte offsets of the `NumFrames` and `OrigNumFrames` placeholders.
-    count_at: [u64; 2],
-    /// C3D: parameter blocks reserved.
-    c3d_blocks: usize,
     /// Timecode and measured rate.
     time: RecordTime,
-    /// TRC: byte offset of the `CameraRate` placeholder.
-    camera_rate_at: u64,
     /// One formatted row (text formats), reused.
     line: String,
     /// One encoded frame (C3D), reused.
@@ -143,8 +154,11 @@ impl Recorder {
                 c3d_blocks = c3d::parameter_blocks(&meta, &FrameRange::longest(first_frame)?)?;
             }
         }
-        let out = BufWriter::with_capacity(BUFFER_BYTES, File::create(path)?);
-        let mut rec = Recorder {
+        let (head, header) = header(format, &labels, (rate_hz, first_frame), &time, c3d_blocks)?;
+        let mut file = File::create(path)?;
+        file.write_all(&head)?;
+        let out = DurableFile::start(file, path, header, Behind::Stop)?;
+        Ok(Recorder {
             path: path.to_path_buf(),
             format,
             out: Some(out),
@@ -154,71 +168,38 @@ impl Recorder {
             rate_hz,
             first_frame,
             frames: 0,
-            count_at: [0; 2],
-            c3d_blocks,
             time,
-            camera_rate_at: 0,
-        };
-        rec.write_header()?;
-        Ok(rec)
+        })
     }
 
-    /// Writes the header, with placeholder counts where the format needs them.
-    fn write_header(&mut self) -> Result<(), WriteError> {
-        let mut text = String::new();
-        match self.format {
-            Format::C3d => {
-                // A provisional one-frame range: rewritten on finish.
-                let bytes = c3d::head(
-                    &self.meta(),
-                    &FrameRange::new(self.first_frame, 1)?,
-                    self.c3d_blocks,
-                );
-                self.writer().write_all(&bytes)?;
-                return Ok(());
-            }
-            Format::Csv => {
-                writeln!(text, "# rate_hz={} units=mm", self.rate_hz).expect("String write");
-                text.push_str("frame,time");
-                if self.time.timecode.is_some() {
-                    text.push_str(",timecode");
-                }
-                for label in &self.labels {
-                    for axis in ["x", "y", "z"] {
-                        write!(text, ",{label}_{axis}").expect("String write");
-                    }
-                }
-                text.push('\n');
-            }
-            Format::Trc => {
-                let (rate, first, tc) = (self.rate_hz, self.first_frame, self.time.timecode);
-                let at = trc_header(&mut text, &self.labels, (rate, first), tc.as_ref());
-                [self.count_at[0], self.count_at[1], self.camera_rate_at] = at;
-            }
+    /// What to do when the disk falls 64 MiB behind: stop the recording (the default, for a
+    /// live source that must never wait) or make [`Recorder::push_frame`] wait (an offline
+    /// writer).
+    pub fn when_behind(mut self, behind: Behind) -> Recorder {
+        if let Some(out) = self.out.as_mut() {
+            out.behind = behind;
         }
-        self.writer().write_all(text.as_bytes())?;
-        Ok(())
+        self
     }
 
-    fn meta(&self) -> Meta<'_> {
-        Meta {
-            labels: &self.labels,
-            rate_hz: self.rate_hz,
-            time: Some(&self.time),
-        }
-    }
-
-    /// Sets the measured rate written on finish (C3D `TRIAL:CAMERA_RATE`, TRC `CameraRate`).
+    /// Sets the measured rate written on the next header update (C3D `TRIAL:CAMERA_RATE`, TRC
+    /// `CameraRate`).
     pub fn set_camera_rate(&mut self, rate_hz: f64) {
         if rate_hz.is_finite() && rate_hz > 0.0 {
             self.time.camera_rate_hz = Some(rate_hz);
+            if let Some(out) = &self.out {
+                out.set_camera_rate(rate_hz);
+            }
         }
     }
 
-    fn writer(&mut self) -> &mut BufWriter<File> {
-        self.out
-            .as_mut()
-            .expect("a recorder is only used before finish consumes it")
+    /// Hands one encoded frame to the file's thread.
+    fn append(&mut self, frame: &[u8]) -> Result<(), WriteError> {
+        let out = self
+            .out
+            .as_ref()
+            .expect("a recorder is only used before finish consumes it");
+        out.append(frame).map_err(stopped)
     }
 
     /// Appends one frame: `xyz` is markers × 3 in millimetres, `missing` one flag per marker
@@ -267,7 +248,7 @@ impl Recorder {
                 }
                 let mut bytes = std::mem::take(&mut self.bytes);
                 c3d::encode_frame(xyz, missing, &mut bytes);
-                let written = self.writer().write_all(&bytes);
+                let written = self.append(&bytes);
                 self.bytes = bytes;
                 written?;
             }
@@ -281,7 +262,7 @@ impl Recorder {
                 let tc = (self.format == Format::Csv && self.time.timecode.is_some())
                     .then_some(timecode);
                 self.format_row(&mut line, sep, (xyz, missing), tc);
-                let written = self.writer().write_all(line.as_bytes());
+                let written = self.append(line.as_bytes());
                 self.line = line;
                 written?;
             }
@@ -330,68 +311,94 @@ impl Recorder {
         &self.path
     }
 
-    /// Flushes, patches the counts into the header and closes the file.
+    /// Writes what is left, updates the header's counts, closes and syncs the file.
     ///
     /// # Errors
-    /// An I/O error, or [`C3dLimitError::NoFrames`] for a C3D recording of no frames (the file
-    /// is removed: C3D cannot hold an empty take).
+    /// [`WriteError::Stopped`] when the file stopped on a write error before (it is closed
+    /// valid with the frames that fit) or the close fails; [`C3dLimitError::NoFrames`] for a
+    /// C3D recording of no frames (the file is removed: C3D cannot hold an empty take).
     pub fn finish(mut self) -> Result<RecordSummary, WriteError> {
-        self.finalise()
-    }
-
-    fn finalise(&mut self) -> Result<RecordSummary, WriteError> {
-        let Some(out) = self.out.take() else {
-            return Err(std::io::Error::other("recording already finished").into());
-        };
-        let mut file = out.into_inner().map_err(|e| e.into_error())?;
-        match self.format {
-            Format::Csv => {}
-            Format::Trc => {
-                let count = format!("{:<COUNT_WIDTH$}", self.frames);
-                for at in self.count_at {
-                    file.seek(SeekFrom::Start(at))?;
-                    file.write_all(count.as_bytes())?;
-                }
-                let rate = self.time.camera_rate_hz.unwrap_or(self.rate_hz);
-                let mut rate = format!("{rate:.6}");
-                rate.truncate(RATE_WIDTH);
-                file.seek(SeekFrom::Start(self.camera_rate_at))?;
-                file.write_all(format!("{rate:<RATE_WIDTH$}").as_bytes())?;
-            }
-            Format::C3d => self.patch_c3d(&mut file)?,
+        let out = self
+            .out
+            .take()
+            .expect("a recorder is only used before finish consumes it");
+        let frames = out.finish().map_err(stopped)?;
+        if frames == 0 && self.format == Format::C3d {
+            return Err(C3dLimitError::NoFrames.into());
         }
-        file.sync_data()?;
         Ok(RecordSummary {
             path: self.path.clone(),
             format: self.format,
-            frames: self.frames,
+            frames,
             markers: self.labels.len(),
         })
     }
+}
 
-    /// Pads the data to whole blocks and rewrites header and parameters with the real range.
-    fn patch_c3d(&self, file: &mut File) -> Result<(), WriteError> {
-        let frames = self.frames as usize;
-        let range = match FrameRange::new(self.first_frame, frames) {
-            Ok(range) => range,
-            Err(e) => {
-                // An empty frame range is no C3D file: leave none rather than an unreadable one.
-                let _ = std::fs::remove_file(&self.path);
-                return Err(e.into());
-            }
-        };
-        file.write_all(&vec![0u8; c3d::padding(frames, self.labels.len())])?;
-        file.seek(SeekFrom::Start(0))?;
-        file.write_all(&c3d::head(&self.meta(), &range, self.c3d_blocks))?;
-        Ok(())
+fn stopped(s: Stopped) -> WriteError {
+    WriteError::Stopped {
+        frames: s.frames,
+        cause: s.cause,
     }
 }
 
-impl Drop for Recorder {
-    fn drop(&mut self) {
-        if self.out.is_some() {
-            // Best effort: the owner did not call finish, so nobody can hear an error.
-            let _ = self.finalise();
+/// The header of a new recording (placeholder counts where the format has them), and what
+/// updates it as frames are written.
+fn header(
+    format: Format,
+    labels: &[String],
+    (rate_hz, first_frame): (f64, i64),
+    time: &RecordTime,
+    c3d_blocks: usize,
+) -> Result<(Vec<u8>, Box<dyn Header>), WriteError> {
+    let mut text = String::new();
+    match format {
+        Format::C3d => {
+            let meta = Meta {
+                labels,
+                rate_hz,
+                time: Some(time),
+            };
+            // A provisional one-frame range, rewritten once frames are on disk.
+            let head = c3d::head(&meta, &FrameRange::new(first_frame, 1)?, c3d_blocks);
+            let count = C3dCount {
+                labels: labels.to_vec(),
+                rate_hz,
+                first_frame,
+                time: *time,
+                blocks: c3d_blocks,
+                frame_bytes: labels.len() * 16,
+                on_disk: head.clone(),
+            };
+            Ok((head, Box::new(count)))
+        }
+        Format::Csv => {
+            writeln!(text, "# rate_hz={rate_hz} units=mm").expect("String write");
+            text.push_str("frame,time");
+            if time.timecode.is_some() {
+                text.push_str(",timecode");
+            }
+            for label in labels {
+                for axis in ["x", "y", "z"] {
+                    write!(text, ",{label}_{axis}").expect("String write");
+                }
+            }
+            text.push('\n');
+            Ok((text.into_bytes(), Box::new(CsvRows)))
+        }
+        Format::Trc => {
+            let tc = time.timecode;
+            let at = trc_header(&mut text, labels, (rate_hz, first_frame), tc.as_ref());
+            let count = TrcCount {
+                count_at: [at[0], at[1]],
+                camera_rate_at: at[2],
+                rate_hz,
+                on_disk: (
+                    format!("{:<COUNT_WIDTH$}", 0),
+                    format!("{:<RATE_WIDTH$}", format!("{rate_hz}")),
+                ),
+            };
+            Ok((text.into_bytes(), Box::new(count)))
         }
     }
 }

@@ -1,12 +1,12 @@
 //! The TRC header of a recording: counts and camera rate as blank-padded placeholders that
-//! [`super::Recorder::finish`] patches in place, and the first frame's timecode.
+//! the file's thread patches in place as frames reach the disk, and the first frame's timecode.
 
 use std::fmt::Write as _;
 
 /// Width of the TRC frame-count placeholder: any `u64` fits.
-pub(super) const COUNT_WIDTH: usize = 20;
+pub(crate) const COUNT_WIDTH: usize = 20;
 /// Width of the TRC `CameraRate` placeholder, patched with the measured rate on finish.
-pub(super) const RATE_WIDTH: usize = 20;
+pub(crate) const RATE_WIDTH: usize = 20;
 
 /// Writes the TRC header with blank-padded frame counts and camera rate into `text`, and a
 /// `Timecode` field (the first frame's, `hh:mm:ss:ff.s`, `;` before the frames for drop-frame:

@@ -6,7 +6,7 @@
 //! record, or a last TRC or CSV row without its newline. The readers keep to the header and
 //! stop before a torn row, so such a file reads as the frames its header counts; [`inspect`]
 //! tells what more it holds and [`repair`] makes the header count every whole frame and drops
-//! the torn one. emoshift's [`crate::record::Recorder`] keeps the header at most a second
+//! the torn one. emoshift's [`crate::recorder::Recorder`] keeps the header at most a second
 //! behind the data; files of builds before it said one frame until they were closed.
 //!
 //! ```
