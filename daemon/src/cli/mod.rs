@@ -9,7 +9,7 @@ mod values;
 pub use live::{BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, WireFormat};
 pub use offline::{
     AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InjectArgs, InspectArgs, KeyValue, ProjectArgs,
-    SynthArgs, TrainArgs,
+    RepairArgs, SynthArgs, TrainArgs,
 };
 
 /// A command-line error on one line, as every other failure is: clap's message with its
@@ -74,6 +74,13 @@ pub enum Command {
     /// Show a take's labels, rate, frame range, units and missing samples per marker.
     #[command(after_help = "Examples:\n  emoshift info take.c3d\n  emoshift info take.trc --json")]
     Info(InfoArgs),
+    /// Recover a take cut off by a crash: make its header count every whole frame its data
+    /// holds and drop a frame cut off mid-write.
+    #[command(
+        after_help = "Examples:\n  emoshift repair live.c3d\n  emoshift repair live.trc --out live-repaired.trc\n\n\
+        `emoshift info` says when a take needs it (\"holds 363 frames, header says 1\")."
+    )]
+    Repair(RepairArgs),
     /// Convert a take between C3D, TRC and CSV (format chosen by extension; gaps kept).
     #[command(after_help = "Examples:\n  emoshift convert Facial-Sing.c3d x.trc\n  \
         emoshift convert x.trc y.c3d")]

@@ -6,7 +6,11 @@ use crate::cli::ConvertArgs;
 
 pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
     crate::offline::output::check_out(&args.output, &[&args.input], args.force)?;
+    let cut_off = crate::offline::takes::cut_off(&args.input);
     let take = crate::offline::load_take(&args.input)?;
+    if let Some(note) = cut_off {
+        crate::out!("warning: {} {note}", args.input.display());
+    }
     replay::save(&args.output, &take).with_context(|| format!("{}", args.output.display()))?;
     let gaps: usize = take.missing.iter().filter(|&&m| m).count();
     if let Some(note) = crate::offline::takes::analog_left_out(&args.input) {

@@ -19,6 +19,9 @@ struct Info<'a> {
     /// Analog samples per frame (C3D), which emoshift does not read.
     #[serde(skip_serializing_if = "Option::is_none")]
     analog_per_frame: Option<usize>,
+    /// What is wrong with the file and what to do (a take cut off by a crash).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    warnings: Vec<String>,
     marker_list: Vec<MarkerInfo<'a>>,
 }
 
@@ -29,7 +32,17 @@ struct MarkerInfo<'a> {
 }
 
 pub(crate) fn run(args: &InfoArgs) -> Result<()> {
-    let take = crate::offline::load_take(&args.file)?;
+    let cut_off = crate::offline::takes::cut_off(&args.file);
+    let take = match crate::offline::load_take(&args.file) {
+        Ok(take) => take,
+        // A take killed before its header counted a frame reads as none: say what it holds.
+        Err(e) => {
+            return Err(match cut_off {
+                Some(note) => e.context(format!("{} {note}", args.file.display())),
+                None => e,
+            })
+        }
+    };
     let per_marker = take.missing_per_marker();
     let frames = take.n_frames();
     let info = Info {
@@ -43,6 +56,7 @@ pub(crate) fn run(args: &InfoArgs) -> Result<()> {
         source_units: take.source_units.as_str(),
         missing_samples: per_marker.iter().sum(),
         analog_per_frame: crate::offline::takes::analog_samples(&args.file),
+        warnings: cut_off.into_iter().collect(),
         marker_list: take
             .labels
             .iter()
@@ -79,6 +93,9 @@ fn print_text(info: &Info<'_>) -> Result<()> {
     crate::out!("missing:  {} samples ({pct:.2} %)", info.missing_samples);
     if let Some(n) = info.analog_per_frame {
         crate::out!("analog:   {n} samples per frame (not read: emoshift reads the markers)");
+    }
+    for w in &info.warnings {
+        crate::out!("warning:  {w}");
     }
     let width = info
         .marker_list

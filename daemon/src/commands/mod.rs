@@ -11,6 +11,7 @@ mod inspect;
 pub mod progress;
 mod project;
 mod record;
+mod repair;
 mod replay;
 mod serve;
 mod synth;
@@ -58,6 +59,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Synth(args) => synth::run(&args),
         Command::Info(args) => info::run(&args),
         Command::Inject(args) => inject::run(&args),
+        Command::Repair(args) => repair::run(&args),
         Command::Convert(args) => convert::run(&args),
         Command::Train(args) => train::run(&args),
         Command::Project(args) => project::run(&args),

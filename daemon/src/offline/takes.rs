@@ -214,6 +214,17 @@ pub fn analog_left_out(path: &Path) -> Option<String> {
     })
 }
 
+/// The warning for a take cut off by a crash (data past its header, a torn last frame), with
+/// what to do: "holds 363 frames, header says 1: run `emoshift repair live.c3d`". `None` for
+/// a whole take, and for a file whose header cannot be read (its reading reports it).
+pub fn cut_off(path: &Path) -> Option<String> {
+    let problem = replay::repair::inspect(path).ok()?.problem()?;
+    Some(format!(
+        "{problem}: run `emoshift repair {}`",
+        path.display()
+    ))
+}
+
 /// Matches a take to a model by label.
 ///
 /// # Errors

@@ -16,6 +16,7 @@ mod emotion_variants;
 mod natnet_alloc;
 mod pipeline_alloc;
 mod realdata;
+mod repair_cli;
 mod replay_cli;
 mod safety;
 mod streamed;
