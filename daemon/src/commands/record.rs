@@ -49,12 +49,27 @@ pub(crate) fn run(args: &RecordArgs) -> Result<()> {
         .enable_all()
         .build()
         .context("starting the tokio runtime")?;
-    let captured = runtime.block_on(async move {
-        let shutdown = CancellationToken::new();
-        tokio::spawn(super::serve::cancel_on_signal(shutdown.clone()));
-        let mut notice = |line: &str| eprintln!("emoshift record: {line}");
-        capture::run(config, shutdown, &mut notice).await
-    })?;
+    let captured = runtime
+        .block_on(async move {
+            let shutdown = CancellationToken::new();
+            tokio::spawn(super::serve::cancel_on_signal(shutdown.clone()));
+            let mut notice = |line: &str| eprintln!("emoshift record: {line}");
+            capture::run(config, shutdown, &mut notice).await
+        })
+        .map_err(|e| {
+            // A full disk: the file is closed valid with the frames that fit; say what to do.
+            let stopped = e.chain().any(|c| {
+                matches!(
+                    c.downcast_ref::<replay::WriteError>(),
+                    Some(replay::WriteError::Stopped { .. })
+                )
+            });
+            if stopped {
+                e.context("recording stopped; free space or record to another disk")
+            } else {
+                e
+            }
+        })?;
     let Some(c) = captured else {
         crate::out!("no frames arrived; nothing written to {}", out.display());
         return Ok(());

@@ -32,6 +32,9 @@ pub(crate) enum Command {
         raw: Option<PathBuf>,
         /// Replace files that exist.
         overwrite: bool,
+        /// The OSC peer that asked, told by `/emoshift/error` if the recording stops by
+        /// itself (a full disk); `None` from the monitor page, which reads `/status`.
+        controller: Option<SocketAddr>,
     },
     /// Stop recording.
     RecordStop,

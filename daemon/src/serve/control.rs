@@ -129,7 +129,7 @@ pub(crate) enum Answer {
 /// Answers a control over the control socket.
 async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
     let mut out = Vec::with_capacity(2048);
-    match execute(ctx, peer, &control).await {
+    match execute(ctx, peer, &control, Some(peer)).await {
         Answer::Confirmed => encode_confirm_into(&control, &mut out),
         Answer::Refused(e) => encode_error_into(control.address(), &e.to_string(), &mut out),
         Answer::Status(pairs) => encode_status_into(&pairs, &mut out),
@@ -140,7 +140,13 @@ async fn handle(ctx: &ControlCtx, peer: SocketAddr, control: Control) {
 
 /// Carries out a control the guard admitted (allow-list, secret, cookie): the one command
 /// path of the control socket and the monitor page. A refusal is counted and logged here.
-pub(crate) async fn execute(ctx: &ControlCtx, peer: SocketAddr, control: &Control) -> Answer {
+/// `osc_peer` hears later news of what it started over OSC (a recording that stops by itself).
+pub(crate) async fn execute(
+    ctx: &ControlCtx,
+    peer: SocketAddr,
+    control: &Control,
+    osc_peer: Option<SocketAddr>,
+) -> Answer {
     let result = match control {
         Control::Status => {
             let pairs = ctx.stats.lock().map(|s| s.pairs()).unwrap_or_default();
@@ -168,6 +174,7 @@ pub(crate) async fn execute(ctx: &ControlCtx, peer: SocketAddr, control: &Contro
                     path,
                     raw,
                     overwrite,
+                    controller: osc_peer,
                 },
             )
             .await

@@ -46,6 +46,7 @@ pub struct Bound {
     /// The frame socket again, for telling a source why its datagram was refused.
     replies: std::net::UdpSocket,
     control: UdpSocket,
+    control_news: std::net::UdpSocket,
     config: Config,
     model: Arc<IcaModel>,
     performers: Vec<Performer>,
@@ -87,9 +88,14 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
     replies.set_nonblocking(true)?;
     frames.set_nonblocking(true)?;
     let frames = UdpSocket::from_std(frames)?;
-    let control = UdpSocket::bind(config.control)
-        .await
+    let control = std::net::UdpSocket::bind(config.control)
         .with_context(|| format!("binding the control socket {}", config.control))?;
+    // The recording's way to tell a controller news it did not ask for (a full disk), from
+    // the address its answers come from.
+    let control_news = control.try_clone().context("cloning the control socket")?;
+    control_news.set_nonblocking(true)?;
+    control.set_nonblocking(true)?;
+    let control = UdpSocket::from_std(control)?;
     let natnet = match config.natnet.clone() {
         Some(n) => {
             let counters = Arc::new(InputCounters::named("natnet"));
@@ -106,6 +112,7 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
         frames,
         replies,
         control,
+        control_news,
         config,
         model,
         performers,
@@ -185,7 +192,7 @@ impl Bound {
         };
         let feed = self.config.monitor.map(|_| Feed::new(board));
         let pipeline = processing_pipeline(self.model, self.performers, &self.config);
-        let outputs = outputs(&self.config, feed)?;
+        let outputs = outputs(&self.config, feed, self.control_news)?;
         let window = self.config.poll_window;
         let processing = Processing::new((pipeline, outputs), window, (ends, cmd_rx), shared);
         let processing = tracker.spawn_blocking(move || processing.run());
@@ -224,7 +231,11 @@ fn processing_pipeline(
 
 /// Every output: the OSC subscribers, the session recording, the monitor feed when the page
 /// is served. A new sink is one more line here.
-fn outputs(config: &Config, feed: Option<Feed>) -> Result<Outputs> {
+fn outputs(
+    config: &Config,
+    feed: Option<Feed>,
+    control_news: std::net::UdpSocket,
+) -> Result<Outputs> {
     let osc = OscOutput::new(&OscOutputConfig {
         send: config.send.clone(),
         max_subscribers: config.max_subscribers,
@@ -238,7 +249,7 @@ fn outputs(config: &Config, feed: Option<Feed>) -> Result<Outputs> {
     }
     Ok(Outputs {
         osc,
-        recorder: Recorder::new(),
+        recorder: Recorder::new().telling(control_news),
         others,
     })
 }

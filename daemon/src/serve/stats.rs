@@ -69,6 +69,8 @@ pub struct Stats {
     pub stream_latency_us: Vec<(i32, Histogram<u64>)>,
     /// The recording running: the edited stream's file, and the raw input's.
     pub recording: Option<(String, Option<String>)>,
+    /// Why the last recording stopped by itself (a full disk), until the next `/record/start`.
+    pub recording_error: Option<String>,
     /// The monitor page's counters (all 0 when it is off).
     pub monitor: MonitorCounters,
 }
@@ -135,6 +137,7 @@ impl Stats {
             sources: Vec::new(),
             stream_latency_us: Vec::new(),
             recording: None,
+            recording_error: None,
             monitor: MonitorCounters::default(),
         }
     }
@@ -200,6 +203,8 @@ impl Stats {
         out.push(("model".into(), StatusValue::Text(self.model.clone())));
         let recording = self.recording.as_ref().map_or("", |r| r.0.as_str());
         out.push(("recording".into(), StatusValue::Text(recording.into())));
+        let error = self.recording_error.as_deref().unwrap_or("");
+        out.push(("recording_error".into(), StatusValue::Text(error.into())));
         for st in &self.per_stream {
             stream_pairs(st, &mut out);
         }

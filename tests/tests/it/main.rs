@@ -1,6 +1,7 @@
 //! End-to-end tests of `emoshift serve` on loopback: one binary, one topic per module.
 
 mod control;
+mod crash;
 mod edit;
 mod faults;
 mod monitor;

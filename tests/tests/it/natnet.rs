@@ -3,7 +3,7 @@
 //! with its drop-frame timecode; the server restarting costs only the frames sent while it
 //! was down; `/status` tells the session and the latency from mid-exposure.
 
-use std::net::{SocketAddr, UdpSocket};
+use std::net::SocketAddr;
 use std::time::{Duration, Instant};
 
 use daemon::loopback::motive::{Motive, MotiveOptions};
@@ -18,13 +18,6 @@ const QUIET: Duration = Duration::from_millis(600);
 const PERIOD: Duration = Duration::from_micros(8_333);
 
 /// A free loopback port (bound, then released).
-fn free_port() -> u16 {
-    UdpSocket::bind("127.0.0.1:0")
-        .and_then(|s| s.local_addr())
-        .expect("a free port")
-        .port()
-}
-
 /// A stand-in describing one markerset "Face" with the model's marker names.
 fn motive(m: &ModelFile, command: SocketAddr, multicast: Option<SocketAddr>) -> Motive {
     let defs = ModelDefs {

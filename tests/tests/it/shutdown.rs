@@ -8,13 +8,6 @@ use protocol::{encode_frame_into, encode_labels_into, Control, FrameBuf, Labels,
 
 use super::support::*;
 
-fn free_port() -> u16 {
-    std::net::UdpSocket::bind("127.0.0.1:0")
-        .and_then(|s| s.local_addr())
-        .expect("an ephemeral port")
-        .port()
-}
-
 #[tokio::test]
 async fn a_recording_is_complete_after_sigterm() {
     let m = model_file(31);

@@ -185,13 +185,6 @@ async fn two_performers_into_one_subscriber_are_told_apart_and_labelled() {
 }
 
 /// A free loopback port (bound, then released).
-fn free_port() -> u16 {
-    UdpSocket::bind("127.0.0.1:0")
-        .and_then(|s| s.local_addr())
-        .expect("an ephemeral port")
-        .port()
-}
-
 #[tokio::test]
 async fn a_static_receiver_that_starts_3_s_late_then_gets_every_frame() {
     let m = model_file(42);

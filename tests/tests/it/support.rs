@@ -74,6 +74,14 @@ impl Daemon {
     }
 }
 
+/// A UDP port free on loopback now (a child process binds it next).
+pub fn free_port() -> u16 {
+    std::net::UdpSocket::bind("127.0.0.1:0")
+        .and_then(|s| s.local_addr())
+        .expect("an ephemeral port")
+        .port()
+}
+
 /// The frames of a synthetic take, model order.
 pub fn take_frames(model: &IcaModel, n: usize) -> Vec<Vec<f32>> {
     (0..n)

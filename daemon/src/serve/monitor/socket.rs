@@ -103,7 +103,7 @@ async fn command(m: &Monitor, peer: SocketAddr, bytes: &[u8]) -> String {
             count_refusal(&m.ctx, peer, &address, &e);
             Answer::Refused(e)
         }
-        Ok(control) => execute(&m.ctx, peer, &control).await,
+        Ok(control) => execute(&m.ctx, peer, &control, None).await,
         Err(e) => {
             count_refusal(&m.ctx, peer, &address, &e);
             Answer::Refused(e)

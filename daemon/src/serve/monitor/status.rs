@@ -93,6 +93,7 @@ impl Health {
             "streams": s.per_stream.iter().map(stream).collect::<Vec<_>>(),
             "subscribers": s.subscribers.iter().map(subscriber).collect::<Vec<_>>(),
             "recording": s.recording.as_ref().map(|(p, raw)| json!({"path": p, "raw": raw})),
+            "recording_error": s.recording_error,
         });
         Health { value }
     }

@@ -279,6 +279,7 @@ impl Processing {
         let _ = s.sent_us.add(&osc.sent_us);
         osc.sent_us.reset();
         (s.poll_hits, s.poll_misses) = (self.poll_hits, self.poll_misses);
+        s.recording_error = self.outputs.recorder.error().map(str::to_string);
         s.recording = self.outputs.recorder.paths().map(|(path, raw)| {
             let show = |p: &Path| p.display().to_string();
             (show(path), raw.map(show))

@@ -26,10 +26,11 @@ impl Processing {
                 path,
                 raw,
                 overwrite,
+                controller,
             } => self
                 .outputs
                 .recorder
-                .start(&path, raw.as_deref(), overwrite),
+                .start(&path, raw.as_deref(), overwrite, controller),
             // Answered by the closing thread once the files are complete (after an fsync each,
             // so the merge below comes first).
             Command::RecordStop => {

@@ -96,6 +96,12 @@ impl File {
         self.error = Some(e.to_string());
     }
 
+    /// Why this file stopped (a full disk, a write error: the writer's message, naming the
+    /// frames kept and the OS's cause), and its path; `None` while it records.
+    pub(super) fn stopped(&self) -> Option<(&std::path::Path, &str)> {
+        self.error.as_deref().map(|e| (self.path.as_path(), e))
+    }
+
     /// Closes the file; frames written.
     pub(super) fn finish(self) -> Result<u64, RecordError> {
         let write_error = |message: String| RecordError::Write {

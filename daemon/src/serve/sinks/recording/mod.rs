@@ -141,6 +141,11 @@ pub struct Recording {
     no_gaps: Vec<bool>,
     /// The input's gaps, source order.
     input_gaps: Vec<bool>,
+    /// Why a file stopped (a full disk): the file and the cause. The recording is over then;
+    /// the processing thread closes it and tells the controller.
+    stopped: Option<String>,
+    /// Who started it over OSC, told by `/emoshift/error` if it stops by itself.
+    controller: Option<std::net::SocketAddr>,
 }
 
 /// `path` made absolute (not resolving links), for comparing paths given differently.
@@ -234,7 +239,27 @@ impl Recording {
             taken: Vec::new(),
             no_gaps: Vec::new(),
             input_gaps: Vec::new(),
+            stopped: None,
+            controller: None,
         })
+    }
+
+    /// Names the OSC peer that started the recording, told if it stops by itself.
+    pub fn told_to(mut self, controller: Option<std::net::SocketAddr>) -> Recording {
+        self.controller = controller;
+        self
+    }
+
+    /// The OSC peer that started the recording.
+    pub fn controller(&self) -> Option<std::net::SocketAddr> {
+        self.controller
+    }
+
+    /// Why the recording stopped by itself, naming the file, the frames it keeps and the
+    /// cause ("live.c3d: stopped after 361 frames, which the file keeps: No space left on
+    /// device (os error 28)"); `None` while it records.
+    pub fn stopped(&self) -> Option<&str> {
+        self.stopped.as_deref()
     }
 
     /// The edited stream's first file, and the raw input's, as given.
@@ -279,6 +304,12 @@ impl Recording {
                 .extend((0..n).map(|i| e.input.is_missing(i)));
             let xyz = &e.input.positions()[..n * 3];
             raw.push(frame, xyz, &self.input_gaps);
+        }
+        if self.stopped.is_none() {
+            let raw = files.raw.as_ref().and_then(File::stopped);
+            if let Some((path, why)) = files.edited.stopped().or(raw) {
+                self.stopped = Some(format!("{}: {why}", path.display()));
+            }
         }
     }
 

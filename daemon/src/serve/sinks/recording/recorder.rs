@@ -3,6 +3,7 @@
 //! shutdown, each close on its own thread (every file ends with an fsync, which must not hold
 //! up the frames).
 
+use std::net::{SocketAddr, UdpSocket};
 use std::path::Path;
 use std::thread::JoinHandle;
 
@@ -17,12 +18,29 @@ use crate::serve::command::{Refusal, Reply};
 pub struct Recorder {
     running: Option<Recording>,
     closing: Vec<JoinHandle<()>>,
+    /// Why the last recording stopped by itself (a full disk), until the next start.
+    error: Option<String>,
+    /// The control socket, to tell a controller its recording stopped (`None` in tests).
+    news: Option<UdpSocket>,
 }
 
 impl Recorder {
     /// No recording.
     pub fn new() -> Recorder {
         Recorder::default()
+    }
+
+    /// Tells a recording's controller over `socket` (the control socket) when it stops by
+    /// itself.
+    pub fn telling(mut self, socket: UdpSocket) -> Recorder {
+        self.news = Some(socket);
+        self
+    }
+
+    /// Why the last recording stopped by itself (a full disk, a write error), naming the
+    /// file, the frames it keeps and the cause, until the next `/record/start`.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
     }
 
     /// The running recording's files: the edited stream's first, and the raw input's.
@@ -32,7 +50,14 @@ impl Recorder {
 
     /// Starts a recording: refused while one runs to the same path; one running to another
     /// path is closed once the new one is ready (a bad new path leaves it running).
-    pub(crate) fn start(&mut self, path: &Path, raw: Option<&Path>, overwrite: bool) -> Reply {
+    /// `controller`, the OSC peer asking, hears `/emoshift/error` if it stops by itself.
+    pub(crate) fn start(
+        &mut self,
+        path: &Path,
+        raw: Option<&Path>,
+        overwrite: bool,
+        controller: Option<SocketAddr>,
+    ) -> Reply {
         let refused = |e: RecordError| Refusal::from_error(Refusal::Record, &e);
         if let Some(running) = &self.running {
             if running.writes_to(path) {
@@ -40,7 +65,10 @@ impl Recorder {
                 return Err(refused(RecordError::Running { path }));
             }
         }
-        let rec = Recording::start(path, raw, overwrite).map_err(refused)?;
+        let rec = Recording::start(path, raw, overwrite)
+            .map_err(refused)?
+            .told_to(controller);
+        self.error = None;
         if let Some(old) = self.running.replace(rec) {
             tracing::info!(target: "emoshift", to = %path.display(), "recording closed for a new one");
             self.closing.push(close_in_background(old, None));
@@ -93,7 +121,34 @@ impl Sink for Recorder {
     fn handle_frame(&mut self, frame: &Processed<'_>) {
         if let Some(rec) = self.running.as_mut() {
             rec.push(&RecordFrame::of(frame));
+            if rec.stopped().is_some() {
+                self.stopped();
+            }
         }
+    }
+}
+
+impl Recorder {
+    /// A recording that stopped by itself (a full disk, a write error): closed with the
+    /// frames that fit, and the cause told in the log, to the controller that started it
+    /// (`/emoshift/error`) and in `/status` (`recording` cleared, `recording_error` set). The
+    /// stream goes on.
+    fn stopped(&mut self) {
+        let Some(rec) = self.running.take() else {
+            return;
+        };
+        let why = format!(
+            "recording stopped: {}; free space or /record/start to another disk",
+            rec.stopped().unwrap_or("a write error")
+        );
+        tracing::error!(target: "emoshift", error = %why, "recording stopped; the stream goes on");
+        if let (Some(socket), Some(to)) = (&self.news, rec.controller()) {
+            let mut out = Vec::with_capacity(256);
+            protocol::encode_error_into(protocol::address::RECORD_START, &why, &mut out);
+            let _ = socket.send_to(&out, to);
+        }
+        self.error = Some(why);
+        self.closing.push(close_in_background(rec, None));
     }
 }
 
