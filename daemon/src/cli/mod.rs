@@ -1,6 +1,8 @@
 //! The command line: one clap-derive enum of subcommands, each a thin front end.
 
-use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
 
 mod live;
 mod offline;
@@ -9,7 +11,7 @@ mod values;
 pub use live::{BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, WireFormat};
 pub use offline::{
     AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InjectArgs, InspectArgs, KeyValue, ProjectArgs,
-    RepairArgs, SynthArgs, TrainArgs,
+    SynthArgs, TrainArgs,
 };
 
 /// A command-line error on one line, as every other failure is: clap's message with its
@@ -142,4 +144,17 @@ pub enum Command {
         after_help = "Examples:\n  emoshift demo\n  emoshift demo --keep demo-out\n  emoshift demo --real"
     )]
     Demo(DemoArgs),
+}
+
+/// `emoshift repair`.
+#[derive(Debug, Args)]
+pub struct RepairArgs {
+    /// The take cut off by a crash (.c3d, .trc or .csv); repaired in place unless --out.
+    pub file: PathBuf,
+    /// Write the repaired take here instead, leaving FILE as it is.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Overwrite --out if it exists.
+    #[arg(long)]
+    pub force: bool,
 }

@@ -130,19 +130,6 @@ pub struct InfoArgs {
     pub json: bool,
 }
 
-/// `emoshift repair`.
-#[derive(Debug, Args)]
-pub struct RepairArgs {
-    /// The take cut off by a crash (.c3d, .trc or .csv); repaired in place unless --out.
-    pub file: PathBuf,
-    /// Write the repaired take here instead, leaving FILE as it is.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Overwrite --out if it exists.
-    #[arg(long)]
-    pub force: bool,
-}
-
 /// `emoshift convert`.
 #[derive(Debug, Args)]
 pub struct ConvertArgs {

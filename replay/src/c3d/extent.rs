@@ -17,7 +17,29 @@ use super::frames::read_head;
 use super::layout::Layout;
 use super::params::{Param, Params, Value};
 use crate::error::ReadError;
-use crate::repair::RepairError;
+
+/// Why [`patch`] could not make the header count the frames (the repair module's
+/// `RepairError` gives each its message).
+#[derive(Debug)]
+pub(crate) enum PatchError {
+    /// No frame to count.
+    NoFrames,
+    /// A range past the header's 16-bit last frame, and no TRIAL:ACTUAL_END_FIELD.
+    NoRoom {
+        /// First frame.
+        first: i64,
+        /// Last frame.
+        last: i64,
+    },
+    /// An I/O error.
+    Io(std::io::Error),
+}
+
+impl From<std::io::Error> for PatchError {
+    fn from(e: std::io::Error) -> PatchError {
+        PatchError::Io(e)
+    }
+}
 
 /// Byte offset of the header's last-frame word.
 const HEADER_LAST_FRAME: u64 = 8;
@@ -103,17 +125,17 @@ pub(crate) fn measure(file: &mut File) -> Result<Extent, ReadError> {
 /// after the last of them and padded with zeros to a whole block.
 ///
 /// # Errors
-/// [`RepairError::NoFrames`], [`RepairError::NoRoom`] or an I/O error.
-pub(crate) fn patch(file: &mut File, e: &Extent, frames: usize) -> Result<(), RepairError> {
+/// [`PatchError::NoFrames`], [`PatchError::NoRoom`] or an I/O error.
+pub(crate) fn patch(file: &mut File, e: &Extent, frames: usize) -> Result<(), PatchError> {
     if frames == 0 {
-        return Err(RepairError::NoFrames);
+        return Err(PatchError::NoFrames);
     }
     let first = e.first_frame;
     let last = first + frames as i64 - 1;
     let long = frames > usize::from(u16::MAX) || last > i64::from(u16::MAX);
     let [point_frames, long_frames, end_field] = &e.fields;
     if long && end_field.is_none() {
-        return Err(RepairError::NoRoom { first, last });
+        return Err(PatchError::NoRoom { first, last });
     }
     let p = e.processor;
     let saturated = |v: i64| u16::try_from(v).unwrap_or(u16::MAX);

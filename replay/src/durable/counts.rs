@@ -8,7 +8,11 @@ use std::path::Path;
 
 use super::Header;
 use crate::c3d::write::{self as c3d, FrameRange, Meta};
-use crate::recorder::trc_header::{COUNT_WIDTH, RATE_WIDTH};
+
+/// Width of the TRC frame-count placeholder: any `u64` fits.
+pub(crate) const COUNT_WIDTH: usize = 20;
+/// Width of the TRC `CameraRate` placeholder, patched with the measured rate on finish.
+pub(crate) const RATE_WIDTH: usize = 20;
 use crate::take::RecordTime;
 
 /// Writes `bytes` at `at`.

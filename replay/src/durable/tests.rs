@@ -2,7 +2,7 @@
 //! the whole frames, a disk far behind stops the file (or makes the caller wait).
 
 use std::fs::File;
-use std::io::Read;
+use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 

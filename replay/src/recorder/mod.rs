@@ -66,7 +66,9 @@ use crate::{Format, Take};
 
 pub use crate::durable::{Behind, FLUSH, SYNC};
 
+mod csv_header;
 pub(crate) mod trc_header;
+use csv_header::csv_header;
 use trc_header::{trc_header, COUNT_WIDTH, RATE_WIDTH};
 
 /// What a finished recording holds.
@@ -373,17 +375,7 @@ fn header(
             Ok((head, Box::new(count)))
         }
         Format::Csv => {
-            writeln!(text, "# rate_hz={rate_hz} units=mm").expect("String write");
-            text.push_str("frame,time");
-            if time.timecode.is_some() {
-                text.push_str(",timecode");
-            }
-            for label in labels {
-                for axis in ["x", "y", "z"] {
-                    write!(text, ",{label}_{axis}").expect("String write");
-                }
-            }
-            text.push('\n');
+            csv_header(&mut text, labels, rate_hz, time.timecode.is_some());
             Ok((text.into_bytes(), Box::new(CsvRows)))
         }
         Format::Trc => {

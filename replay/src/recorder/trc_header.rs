@@ -3,10 +3,7 @@
 
 use std::fmt::Write as _;
 
-/// Width of the TRC frame-count placeholder: any `u64` fits.
-pub(crate) const COUNT_WIDTH: usize = 20;
-/// Width of the TRC `CameraRate` placeholder, patched with the measured rate on finish.
-pub(crate) const RATE_WIDTH: usize = 20;
+pub(crate) use crate::durable::{COUNT_WIDTH, RATE_WIDTH};
 
 /// Writes the TRC header with blank-padded frame counts and camera rate into `text`, and a
 /// `Timecode` field (the first frame's, `hh:mm:ss:ff.s`, `;` before the frames for drop-frame:

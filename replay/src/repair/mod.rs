@@ -115,6 +115,17 @@ pub enum RepairError {
     Verify(#[source] ReadError),
 }
 
+impl From<crate::c3d::extent::PatchError> for RepairError {
+    fn from(e: crate::c3d::extent::PatchError) -> RepairError {
+        use crate::c3d::extent::PatchError;
+        match e {
+            PatchError::NoFrames => RepairError::NoFrames,
+            PatchError::NoRoom { first, last } => RepairError::NoRoom { first, last },
+            PatchError::Io(e) => RepairError::Io(e),
+        }
+    }
+}
+
 /// What [`repair`] did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Repaired {
