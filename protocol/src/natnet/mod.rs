@@ -1,5 +1,6 @@
 //! NatNet, OptiTrack Motive's streaming protocol: packet framing, frames of mocap data, model
-//! definitions, command messages, and a sans-IO client session ([`Client`]).
+//! definitions, command messages, a sans-IO client session ([`Client`]), and the server's
+//! side of the command channel ([`decode_command`], the replies).
 //!
 //! Like the rest of this crate: no sockets, no clock, no threads. Decoders take a whole UDP
 //! datagram (header included); encoders write a whole datagram into a caller `Vec<u8>`.
@@ -88,6 +89,7 @@ mod frame_parts;
 mod message;
 mod modeldef;
 mod modeldef_encode;
+mod server;
 mod version;
 mod wire;
 
@@ -110,6 +112,10 @@ pub use modeldef::{
     RigidBodyDef, RigidBodyMarkerDef, SkeletonDef,
 };
 pub use modeldef_encode::encode_model_defs_into;
+pub use server::{
+    decode_command, encode_response_code_into, encode_response_f32_into, encode_unrecognized_into,
+    parse_request, Command, Hello, Request, MAX_COMMAND_LEN,
+};
 pub use version::{parse_bitstream_reply, NatNetVersion};
 
 /// Motive's default command port.
