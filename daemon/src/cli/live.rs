@@ -41,6 +41,27 @@ pub struct ServeArgs {
     /// The NatNet source's settings.
     #[command(flatten)]
     pub natnet_options: NatNetArgs,
+    /// Be a NatNet server (Motive's look) for OptiTrack's Unreal, Unity and MotionBuilder
+    /// plugins and NatNet clients: the command port, IP[:PORT] [default: 127.0.0.1:1510]; the
+    /// data port is PORT+1. Beside Motive on one host pick other ports, e.g. 127.0.0.1:1512.
+    #[arg(long, value_name = "IP:PORT", num_args = 0..=1,
+          default_missing_value = crate::serve::sinks::natnet::DEFAULT_NATNET_SERVER)]
+    pub natnet_server: Option<String>,
+    /// Multicast the NatNet server's frames to this group, GROUP[:PORT] [239.255.42.99, the
+    /// data port], instead of unicast to each client.
+    #[arg(long, value_name = "GROUP[:PORT]", num_args = 0..=1, default_missing_value = "",
+          requires = "natnet_server")]
+    pub natnet_server_multicast: Option<String>,
+    /// Local IPv4 address the NatNet server multicasts on [default: the command address's].
+    #[arg(long, value_name = "IP", requires = "natnet_server")]
+    pub natnet_server_interface: Option<String>,
+    /// The bitstream the NatNet server streams unless a client asks for another (3.1 for
+    /// Motive 2.x clients, 4.1) [default: 4.1].
+    #[arg(long, value_name = "VERSION", requires = "natnet_server")]
+    pub natnet_server_version: Option<String>,
+    /// Also stream each performer's unedited input as a `<name>_raw` markerset (A/B).
+    #[arg(long, requires = "natnet_server")]
+    pub natnet_server_raw: bool,
 }
 
 /// The NatNet options `serve` and `record` share (each needs `--natnet`).

@@ -38,6 +38,16 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if let Some(l) = args.lowpass {
         raw.lowpass_s = Some(l);
     }
+    natnet_flags(args, &mut raw);
+    if let Some(m) = &args.monitor {
+        raw.monitor = Some(m.clone());
+    }
+    raw.validate().map_err(|e| UsageError(e.to_string()).into())
+}
+
+/// The NatNet flags (the source's `--natnet*`, the server's `--natnet-server*`) over their
+/// keys.
+fn natnet_flags(args: &ServeArgs, raw: &mut RawConfig) {
     let flags = args.natnet_options.raw(args.natnet.clone());
     for (flag, key) in [
         (flags.server, &mut raw.natnet),
@@ -50,10 +60,25 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
             *key = flag;
         }
     }
-    if let Some(m) = &args.monitor {
-        raw.monitor = Some(m.clone());
+    for (flag, key) in [
+        (&args.natnet_server, &mut raw.natnet_server),
+        (
+            &args.natnet_server_multicast,
+            &mut raw.natnet_server_multicast,
+        ),
+        (
+            &args.natnet_server_interface,
+            &mut raw.natnet_server_interface,
+        ),
+        (&args.natnet_server_version, &mut raw.natnet_server_version),
+    ] {
+        if flag.is_some() {
+            key.clone_from(flag);
+        }
     }
-    raw.validate().map_err(|e| UsageError(e.to_string()).into())
+    if args.natnet_server_raw {
+        raw.natnet_server_raw = Some(true);
+    }
 }
 
 pub(crate) fn run(args: &ServeArgs) -> Result<()> {

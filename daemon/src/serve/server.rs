@@ -30,6 +30,7 @@ use super::control::{self, ControlCtx, Guard};
 use super::monitor::{Board, Feed};
 use super::processing::{Processing, Shared};
 use super::queue::Queue;
+use super::sinks::natnet::{self as natnet_server, NatNetServer, NatNetSink};
 use super::sinks::osc::{OscOutput, OscOutputConfig};
 use super::sinks::recording::Recorder;
 use super::sinks::Outputs;
@@ -54,6 +55,8 @@ pub struct Bound {
     natnet: Option<(Link, Arc<InputCounters>)>,
     /// The monitor page's listener, when the page is served.
     monitor: Option<tokio::net::TcpListener>,
+    /// The NatNet server's sockets, when one is configured.
+    natnet_server: Option<NatNetServer>,
 }
 
 /// Binds both sockets and loads the models, so that a test learns the addresses before frames
@@ -107,8 +110,20 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
         Some(addr) => Some(super::monitor::bind(addr).await?),
         None => None,
     };
+    let natnet_server = match &config.natnet_server {
+        Some(n) => {
+            let max_markers = PipelineConfig::default().max_markers;
+            Some(natnet_server::open(
+                n,
+                config.control_allow.clone(),
+                max_markers,
+            )?)
+        }
+        None => None,
+    };
     Ok(Bound {
         monitor,
+        natnet_server,
         frames,
         replies,
         control,
@@ -143,6 +158,17 @@ impl Bound {
     /// The OS cannot tell.
     pub fn monitor_addr(&self) -> Result<Option<SocketAddr>> {
         Ok(self.monitor.as_ref().map(|l| l.local_addr()).transpose()?)
+    }
+
+    /// The NatNet server's command address, when it is served.
+    ///
+    /// # Errors
+    /// The OS cannot tell.
+    pub fn natnet_server_addr(&self) -> Result<Option<SocketAddr>> {
+        self.natnet_server
+            .as_ref()
+            .map(|n| n.commands.local_addr())
+            .transpose()
     }
 
     /// Serves until `shutdown` is cancelled, then drains and returns.
@@ -192,7 +218,8 @@ impl Bound {
         };
         let feed = self.config.monitor.map(|_| Feed::new(board));
         let pipeline = processing_pipeline(self.model, self.performers, &self.config);
-        let outputs = outputs(&self.config, feed, self.control_news)?;
+        let natnet_sink = spawn_natnet_server(self.natnet_server, &stats, &tracker, &shutdown);
+        let outputs = outputs(&self.config, feed, natnet_sink, self.control_news)?;
         let window = self.config.poll_window;
         let processing = Processing::new((pipeline, outputs), window, (ends, cmd_rx), shared);
         let processing = tracker.spawn_blocking(move || processing.run());
@@ -230,10 +257,11 @@ fn processing_pipeline(
 }
 
 /// Every output: the OSC subscribers, the session recording, the monitor feed when the page
-/// is served. A new sink is one more line here.
+/// is served, the NatNet server when configured. A new sink is one more line here.
 fn outputs(
     config: &Config,
     feed: Option<Feed>,
+    natnet: Option<NatNetSink>,
     control_news: std::net::UdpSocket,
 ) -> Result<Outputs> {
     let osc = OscOutput::new(&OscOutputConfig {
@@ -244,6 +272,9 @@ fn outputs(
         max_markers: PipelineConfig::default().max_markers,
     })?;
     let mut others: Vec<Box<dyn engine::Sink + Send>> = Vec::new();
+    if let Some(natnet) = natnet {
+        others.push(Box::new(natnet));
+    }
     if let Some(feed) = feed {
         others.push(Box::new(feed));
     }
@@ -252,6 +283,24 @@ fn outputs(
         recorder: Recorder::new().telling(control_news),
         others,
     })
+}
+
+/// The NatNet server's command task, its status into `/status`; its frame sink.
+fn spawn_natnet_server(
+    server: Option<NatNetServer>,
+    stats: &Arc<Mutex<Stats>>,
+    tracker: &TaskTracker,
+    shutdown: &CancellationToken,
+) -> Option<NatNetSink> {
+    let server = server?;
+    let stats = Arc::clone(stats);
+    let on_status = move |pairs| {
+        if let Ok(mut s) = stats.lock() {
+            s.set_source_status("natnet_server", pairs);
+        }
+    };
+    tracker.spawn(server.commands.run(on_status, shutdown.clone()));
+    Some(server.sink)
 }
 
 /// Every source's task, its frames into `queue`: the OSC frame socket, the NatNet link when

@@ -101,6 +101,18 @@ pub struct RawConfig {
     pub natnet_names: Option<String>,
     /// NatNet marker names (as built) to model labels.
     pub natnet_rename: HashMap<String, String>,
+    /// The NatNet server's command address, `IP[:PORT]` (see [`super::sinks::natnet`]).
+    pub natnet_server: Option<String>,
+    /// The NatNet server's multicast group, `GROUP[:PORT]` (unicast when absent).
+    pub natnet_server_multicast: Option<String>,
+    /// Local IPv4 address the NatNet server multicasts on.
+    pub natnet_server_interface: Option<String>,
+    /// The NatNet server's default bitstream (`3.1`, `4.1`).
+    pub natnet_server_version: Option<String>,
+    /// A `<name>_raw` markerset with each performer's unedited input too.
+    pub natnet_server_raw: Option<bool>,
+    /// Unicast NatNet clients at most.
+    pub natnet_server_max_clients: Option<usize>,
     /// The monitor page's address (off when absent).
     pub monitor: Option<String>,
     /// The monitor page's token (generated and printed when the page is bound beyond
@@ -145,6 +157,8 @@ pub struct Config {
     pub performers: Vec<PerformerConfig>,
     /// The NatNet source, if any.
     pub natnet: Option<super::sources::natnet::NatNetConfig>,
+    /// The NatNet server, if any.
+    pub natnet_server: Option<super::sinks::natnet::NatNetServerConfig>,
     /// The monitor page's address, if it is served.
     pub monitor: Option<SocketAddr>,
     /// The monitor page's token, if one is set.
@@ -180,8 +194,10 @@ impl RawConfig {
     ///
     /// # Errors
     /// The first bad value, named.
-    pub fn validate(self) -> Result<Config, ConfigError> {
+    pub fn validate(mut self) -> Result<Config, ConfigError> {
         let numbers = self.numbers()?;
+        let natnet = self.take_natnet().validate()?;
+        let natnet_server = self.take_natnet_server().validate()?;
         let send = self
             .send
             .iter()
@@ -223,21 +239,38 @@ impl RawConfig {
                 .into_iter()
                 .map(performer)
                 .collect::<Result<_, _>>()?,
-            natnet: super::sources::natnet::RawNatNet {
-                server: self.natnet,
-                data: self.natnet_data,
-                interface: self.natnet_interface,
-                timecode_rate: self.natnet_timecode_rate,
-                names: self.natnet_names,
-                rename: self.natnet_rename,
-            }
-            .validate()?,
+            natnet,
+            natnet_server,
             monitor: self
                 .monitor
                 .map(|m| addr("monitor", Some(m), ""))
                 .transpose()?,
             monitor_token: check_token(self.monitor_token)?,
         })
+    }
+
+    /// The `natnet*` keys, taken out for the NatNet source's own check.
+    fn take_natnet(&mut self) -> super::sources::natnet::RawNatNet {
+        super::sources::natnet::RawNatNet {
+            server: self.natnet.take(),
+            data: self.natnet_data.take(),
+            interface: self.natnet_interface.take(),
+            timecode_rate: self.natnet_timecode_rate.take(),
+            names: self.natnet_names.take(),
+            rename: std::mem::take(&mut self.natnet_rename),
+        }
+    }
+
+    /// The `natnet_server*` keys, taken out for the NatNet server's own check.
+    fn take_natnet_server(&mut self) -> super::sinks::natnet::RawNatNetServer {
+        super::sinks::natnet::RawNatNetServer {
+            server: self.natnet_server.take(),
+            multicast: self.natnet_server_multicast.take(),
+            interface: self.natnet_server_interface.take(),
+            version: self.natnet_server_version.take(),
+            raw: self.natnet_server_raw.take(),
+            max_clients: self.natnet_server_max_clients.take(),
+        }
     }
 
     /// The numeric keys, each checked against its range.

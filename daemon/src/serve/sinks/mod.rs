@@ -5,6 +5,7 @@
 //! - [`osc`]: the OSC profiles (compact, flat-split, components) to `--send` targets and
 //!   `/subscribe`rs;
 //! - [`recording`]: the session recording (`/record/start`), edited and raw;
+//! - [`natnet`]: the NatNet server (`--natnet-server`): Motive's look to NatNet clients;
 //! - the monitor page's feed ([`crate::serve::monitor::Feed`]), beside the page it feeds.
 //!
 //! [`Outputs`] is the one sink the processing thread hands the engine: it passes each frame to
@@ -13,6 +14,7 @@
 //! [`Outputs`]: a sink with its own sockets and per-client protocol versions keeps them to
 //! itself ([`engine::subscribers`] is the bookkeeping sinks with clients share).
 
+pub mod natnet;
 pub mod osc;
 pub mod recording;
 
