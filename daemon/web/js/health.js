@@ -92,6 +92,24 @@ export function createHealth(sendControl) {
       .forEach((li, i) => setText(li, warnings[i]));
   }
 
+  // The NatNet server's clients (`--natnet-server`), from its `natnet_server/*` pairs.
+  function natnetServer(nn) {
+    $("natnet-server").hidden = !nn;
+    if (!nn) return;
+    const key = (k) => nn[`natnet_server/${k}`];
+    const clients = [];
+    for (let n = 0; key(`client/${n}/addr`) !== undefined; n++) {
+      clients.push([[
+        [key(`client/${n}/addr`)], [key(`client/${n}/version`)],
+        [`${(key(`client/${n}/lease_ms`) / 1000).toFixed(1)} s`, "n"], [fmt(key(`client/${n}/frames`)), "n"],
+      ]]);
+    }
+    rows($("t-natnet").tBodies[0], clients);
+    const mode = key("multicast") ? `multicast ${key("multicast")}` : "unicast";
+    const refused = key("not_allowed") + key("malformed") + key("oversized") + key("over_budget");
+    setText($("natnet-line"), `${mode} · markersets ${key("markersets") || "none yet"} · ${fmt(key("frames_sent"))} frames sent · ${fmt(key("connects"))} connects · ${fmt(refused)} refused`);
+  }
+
   return {
     setModel,
     update(msg, selected) {
@@ -145,6 +163,7 @@ export function createHealth(sendControl) {
         [s.lease_ms === null ? "static" : `${(s.lease_ms / 1000).toFixed(1)} s`, "n"],
         [fmt(s.sends), "n"], [fmt(s.failures), "n"],
       ]]));
+      natnetServer((msg.sources || {}).natnet_server);
       const rec = msg.recording;
       const state = $("rec-state");
       setText(state, rec ? `recording ${rec.path}${rec.raw ? ` + ${rec.raw}` : ""}` : "idle");

@@ -120,3 +120,23 @@ fn the_frame_and_control_sockets_need_their_own_ports() {
         validate(apart).expect("own sockets");
     }
 }
+
+#[test]
+fn natnet_server_keys_reach_the_server_config() {
+    let text = "model = \"m.json\"\nnatnet_server = \"127.0.0.1:1512\"\n\
+                natnet_server_multicast = \"239.255.42.100\"\nnatnet_server_raw = true\n";
+    let c = RawConfig::from_toml(text)
+        .expect("parses")
+        .validate()
+        .expect("valid");
+    let n = c.natnet_server.expect("a NatNet server");
+    assert_eq!(n.command, "127.0.0.1:1512".parse().expect("addr"));
+    assert_eq!(
+        n.multicast,
+        Some("239.255.42.100:1513".parse().expect("addr"))
+    );
+    assert!(n.raw);
+    let text = "model = \"m.json\"\nnatnet_server_raw = true\n";
+    let e = RawConfig::from_toml(text).expect("parses").validate();
+    assert!(e.is_err(), "a server key without natnet_server is named");
+}

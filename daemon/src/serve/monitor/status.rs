@@ -94,6 +94,8 @@ impl Health {
             "subscribers": s.subscribers.iter().map(subscriber).collect::<Vec<_>>(),
             "recording": s.recording.as_ref().map(|(p, raw)| json!({"path": p, "raw": raw})),
             "recording_error": s.recording_error,
+            "sources": s.sources.iter().map(|(name, pairs)| (name.to_string(), pairs_object(pairs)))
+                .collect::<serde_json::Map<_, _>>(),
         });
         Health { value }
     }
@@ -126,6 +128,18 @@ fn stream(st: &StreamStatus) -> Value {
         "duplicates": st.duplicates,
         "stale": st.stale,
     })
+}
+
+/// A source's (or the NatNet server's) own status pairs as one object, by name.
+fn pairs_object(pairs: &[(String, protocol::StatusValue)]) -> Value {
+    let object = pairs.iter().map(|(k, v)| {
+        let v = match v {
+            protocol::StatusValue::Int(i) => json!(i),
+            protocol::StatusValue::Text(t) => json!(t),
+        };
+        (k.clone(), v)
+    });
+    Value::Object(object.collect())
 }
 
 fn subscriber(sub: &SubscriberStatus) -> Value {
