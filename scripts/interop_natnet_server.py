@@ -301,6 +301,9 @@ def compare(what, daemon, client, stream, names, sent_timecodes=None):
         check(f"{what}: frame numbers and timecode (29.97 DF) kept", len(ok) == len(
             sent_timecodes), f"{len(ok)} of {len(sent_timecodes)}")
     check(f"{what}: the client decoded every datagram", client.errors == 0, client.errors)
+    if isinstance(client, PythonNatnetClient):
+        check(f"{what}: the stream's arrival flagged 'tracked models changed' and the client "
+              "fetched the definitions again", client.changed > 0, client.changed)
 
 
 def run_case(work, what, feed, client_kind, server_extra):
