@@ -1,6 +1,6 @@
 //! The NatNet server's command channel, sans-IO: who may connect, what each client is
 //! answered, which clients get frames and in which bitstream. The command task
-//! ([`super::run_commands`]) owns the socket and the clock; the processing thread's sink reads
+//! ([`super::Commands::run`]) owns the socket and the clock; the processing thread's sink reads
 //! the client table through the same lock.
 //!
 //! Call order: [`Session::handle_command`] per datagram (it writes the reply, if any, into the
