@@ -121,6 +121,11 @@ pub struct BenchArgs {
     /// its added latency against OSC's in the same run.
     #[arg(long)]
     pub natnet: bool,
+    /// Also run rounds with a NatNet client on the daemon's `--natnet-server` (unicast, 4.1)
+    /// beside the OSC receivers: the NatNet output's added latency against the OSC compact
+    /// output's in the same run, as a ratio.
+    #[arg(long)]
+    pub natnet_server: bool,
 }
 
 /// `emoshift record`.

@@ -21,6 +21,8 @@ pub struct Daemon {
     pub control: SocketAddr,
     /// Where it serves the monitor page, when `monitor` is set.
     pub monitor: Option<SocketAddr>,
+    /// The NatNet server's command address, when `natnet_server` is set.
+    pub natnet_server: Option<SocketAddr>,
     shutdown: CancellationToken,
     done: Option<tokio::sync::oneshot::Receiver<Result<()>>>,
 }
@@ -54,11 +56,13 @@ impl Daemon {
                 let _ = done_tx.send(result);
             })
             .context("cannot start the daemon thread")?;
-        let (frames, control, monitor) = bound_rx.await.context("the daemon thread ended")??;
+        let (frames, control, monitor, natnet_server) =
+            bound_rx.await.context("the daemon thread ended")??;
         Ok(Daemon {
             frames,
             control,
             monitor,
+            natnet_server,
             shutdown,
             done: Some(done),
         })
@@ -101,7 +105,12 @@ pub fn loopback_config(monitor: Option<&str>) -> Result<Config, ConfigError> {
     .validate()
 }
 
-type Bound = Result<(SocketAddr, SocketAddr, Option<SocketAddr>)>;
+type Bound = Result<(
+    SocketAddr,
+    SocketAddr,
+    Option<SocketAddr>,
+    Option<SocketAddr>,
+)>;
 
 fn serve_until(
     config: Config,
@@ -122,7 +131,10 @@ fn serve_until(
         let addrs = bound
             .as_ref()
             .map_err(|e| anyhow::anyhow!("{e:#}"))
-            .and_then(|b| Ok((b.frame_addr()?, b.control_addr()?, b.monitor_addr()?)));
+            .and_then(|b| {
+                let (frames, control) = (b.frame_addr()?, b.control_addr()?);
+                Ok((frames, control, b.monitor_addr()?, b.natnet_server_addr()?))
+            });
         let _ = bound_tx.send(addrs);
         bound?.run(shutdown).await
     })

@@ -217,7 +217,7 @@ pub(super) fn epoch() -> Instant {
 /// sends into milliseconds). It sleeps to each deadline without spinning, which would take a
 /// core from the daemon on a small machine; the sleep's lateness is the stage's jitter.
 /// Returns frames sent.
-async fn send_all(
+pub(super) async fn send_all(
     model: &IcaModel,
     performers: usize,
     to: SocketAddr,

@@ -17,10 +17,14 @@
 //! multicast loopback is part of the path) and unicast, each compared with the OSC source
 //! measured in the same run.
 //!
+//! With `--natnet-server`, rounds with a NatNet client on the daemon's NatNet server beside
+//! the OSC receivers ([`natnet_server`]): the two outputs' latencies from the same frames.
+//!
 //! Bounded in time, only 127.0.0.1.
 
 mod harness;
 mod natnet;
+mod natnet_server;
 
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -66,6 +70,9 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
             print_natnet(nn, how, (&r.daemon, &r.relay), k)?;
         }
     }
+    if let Some((osc, natnet)) = &r.natnet_server {
+        print_natnet_server(osc, natnet, k)?;
+    }
     if let Some(watched) = &r.watched {
         print_watched(&r.daemon, watched, k)?;
     }
@@ -87,6 +94,8 @@ struct Measured {
     watched: Option<Run>,
     /// The daemon fed over NatNet, multicast and unicast, every round.
     over_natnet: [Option<Run>; 2],
+    /// The daemon with a NatNet server client beside the OSC receivers, every round.
+    natnet_server: Option<(Run, harness::Seen)>,
     /// The daemon at the maximum rate.
     max: Run,
 }
@@ -102,7 +111,19 @@ async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
     let mut relay = through_relay(model, n, k, per_round).await?;
     let mut watched: Option<Run> = None;
     let mut over_natnet: [Option<Run>; 2] = [None, None];
+    let mut natnet_server: Option<(Run, harness::Seen)> = None;
     for round in 0..rounds {
+        if args.natnet_server {
+            let (osc, nn) =
+                natnet_server::through_daemon_natnet_server(model, (n, k), per_round, w).await?;
+            match natnet_server.as_mut() {
+                None => natnet_server = Some((osc, nn)),
+                Some(all) => {
+                    all.0.add(osc);
+                    all.1.add(&nn);
+                }
+            }
+        }
         for (multicast, all) in [true, false].into_iter().zip(over_natnet.iter_mut()) {
             if !args.natnet {
                 break;
@@ -132,6 +153,7 @@ async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
         relay,
         watched,
         over_natnet,
+        natnet_server,
         max,
     })
 }
@@ -198,6 +220,28 @@ fn print_natnet(
              {r} µs, ratio {:.2}x)",
             n as f64 / o.max(1) as f64,
             n as f64 / r.max(1) as f64
+        );
+    }
+    Ok(())
+}
+
+/// The NatNet server's client against the OSC compact receivers of the same runs.
+fn print_natnet_server(osc: &Run, natnet: &harness::Seen, clients: usize) -> Result<()> {
+    crate::out!(
+        "natnet server (unicast 4.1, beside {clients} OSC compact receivers): {} of {} frames \
+         received; osc {} of ~{}",
+        natnet.received,
+        osc.sent,
+        osc.seen.received,
+        osc.sent * clients as u64,
+    );
+    for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999), ("max", 1.0)] {
+        let n = natnet.latency_us.value_at_quantile(q);
+        let o = osc.seen.latency_us.value_at_quantile(q);
+        crate::out!(
+            "{label} added latency of the natnet server output: {n} µs (osc compact, same run, \
+             {o} µs, ratio {:.2}x)",
+            n as f64 / o.max(1) as f64
         );
     }
     Ok(())
