@@ -75,30 +75,14 @@ pub async fn bind(config: Config) -> Result<Bound> {
 /// A socket that cannot be bound or a performer model that cannot be loaded.
 pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
     let model = Arc::new(model);
-    let mut performers = Vec::with_capacity(config.performers.len());
-    for p in config.performers.iter().cloned() {
-        let model = match &p.model {
-            Some(path) => Some(Arc::new(
-                super::load_model(path.clone(), config.max_model_bytes).await?,
-            )),
-            None => None,
-        };
-        performers.push(p.with_model(model));
-    }
+    let performers = load_performers(&config).await?;
     let frames = super::net::bind_receiver_std(config.listen)
         .with_context(|| format!("binding the frame socket {}", config.listen))?;
     let replies = frames.try_clone().context("cloning the frame socket")?;
     replies.set_nonblocking(true)?;
     frames.set_nonblocking(true)?;
     let frames = UdpSocket::from_std(frames)?;
-    let control = std::net::UdpSocket::bind(config.control)
-        .with_context(|| format!("binding the control socket {}", config.control))?;
-    // The recording's way to tell a controller news it did not ask for (a full disk), from
-    // the address its answers come from.
-    let control_news = control.try_clone().context("cloning the control socket")?;
-    control_news.set_nonblocking(true)?;
-    control.set_nonblocking(true)?;
-    let control = UdpSocket::from_std(control)?;
+    let (control, control_news) = bind_control(config.control)?;
     let natnet = match config.natnet.clone() {
         Some(n) => {
             let counters = Arc::new(InputCounters::named("natnet"));
@@ -133,6 +117,32 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
         performers,
         natnet,
     })
+}
+
+/// Each performer with its own model loaded, when it names one.
+async fn load_performers(config: &Config) -> Result<Vec<Performer>> {
+    let mut performers = Vec::with_capacity(config.performers.len());
+    for p in config.performers.iter().cloned() {
+        let model = match &p.model {
+            Some(path) => Some(Arc::new(
+                super::load_model(path.clone(), config.max_model_bytes).await?,
+            )),
+            None => None,
+        };
+        performers.push(p.with_model(model));
+    }
+    Ok(performers)
+}
+
+/// The control socket, and a clone of it: the recording's way to tell a controller news it did
+/// not ask for (a full disk), from the address its answers come from.
+fn bind_control(addr: SocketAddr) -> Result<(UdpSocket, std::net::UdpSocket)> {
+    let control = std::net::UdpSocket::bind(addr)
+        .with_context(|| format!("binding the control socket {addr}"))?;
+    let control_news = control.try_clone().context("cloning the control socket")?;
+    control_news.set_nonblocking(true)?;
+    control.set_nonblocking(true)?;
+    Ok((UdpSocket::from_std(control)?, control_news))
 }
 
 impl Bound {
