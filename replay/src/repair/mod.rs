@@ -25,7 +25,7 @@
 
 mod text;
 
-use std::fs::{File, OpenOptions};
+use std::fs::OpenOptions;
 use std::path::{Path, PathBuf};
 
 use crate::error::ReadError;
@@ -91,6 +91,9 @@ pub enum RepairError {
     /// The header cannot be read: there is nothing to count frames against.
     #[error("the header cannot be read")]
     Read(#[from] ReadError),
+    /// Not a regular file, or it cannot be opened.
+    #[error(transparent)]
+    Open(#[from] crate::file::OpenError),
     /// An I/O error.
     #[error("cannot read or write the file")]
     Io(#[from] std::io::Error),
@@ -146,7 +149,8 @@ pub struct Repaired {
 /// I/O error.
 pub fn inspect(path: &Path) -> Result<Extent, RepairError> {
     let format = Format::from_path(path).ok_or_else(|| RepairError::UnknownFormat(path.into()))?;
-    let mut file = File::open(path)?;
+    // Only a regular file: a link to /dev/zero would be scanned forever, a FIFO would block.
+    let mut file = crate::file::open_bounded(path, u64::MAX)?.into_inner();
     match format {
         Format::C3d => {
             let e = crate::c3d::extent::measure(&mut file)?;
