@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod assess;
+mod rotation;
 mod sample;
 pub mod search;
 
@@ -89,6 +90,7 @@ pub struct PoseEstimate {
 
 /// Kabsch fit of `template` points onto `observed` points (pairs where `present`), minimising the
 /// squared distances. Returns `None` with fewer than three pairs or a degenerate configuration.
+/// The rotation comes from [`rotation::best_rotation`].
 pub(crate) fn kabsch<'a>(
     pairs: impl Iterator<Item = (&'a [f64; 3], Vector3<f64>)> + Clone,
 ) -> Option<(Pose, usize)> {
@@ -106,19 +108,13 @@ pub(crate) fn kabsch<'a>(
     p_mean /= count as f64;
     q_mean /= count as f64;
     let mut h = Matrix3::zeros();
+    let mut norms = 0.0;
     for (p, q) in pairs {
-        h += (Vector3::from(*p) - p_mean) * (q - q_mean).transpose();
+        let (p, q) = (Vector3::from(*p) - p_mean, q - q_mean);
+        h += p * q.transpose();
+        norms += p.norm_squared() + q.norm_squared();
     }
-    let svd = h.svd(true, true);
-    let (u, v_t) = (svd.u?, svd.v_t?);
-    // Two vanishing singular values mean the points are collinear (or coincide).
-    let s = svd.singular_values;
-    if s[1] <= 1e-9 * s[0].max(1e-300) {
-        return None;
-    }
-    let v = v_t.transpose();
-    let d = (v * u.transpose()).determinant().signum();
-    let rotation = v * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d)) * u.transpose();
+    let rotation = rotation::best_rotation(&h, norms)?;
     let translation = q_mean - rotation * p_mean;
     Some((
         Pose {
