@@ -15,7 +15,6 @@
 //!   (high).
 
 use nalgebra::{Matrix3, SMatrix, SVector, SymmetricEigen, Vector3};
-use rayon::prelude::*;
 
 use super::sample::Sample;
 use super::{centre, kabsch, point, Pose};
@@ -52,6 +51,9 @@ pub struct GroupAssessment {
 
     /// The capture's noise per coordinate, mm.
     pub noise_mm: f64,
+    /// The group's shape (centred, mm, group order) by generalised Procrustes averaging over
+    /// the sample: the head reference's template when the group is chosen.
+    pub template: Vec<[f64; 3]>,
 }
 
 impl GroupAssessment {
@@ -62,53 +64,62 @@ impl GroupAssessment {
     }
 }
 
-/// One frame of the group: its pose and fit residual, and the other markers in head
-/// coordinates.
-struct Fitted {
-    pose: Pose,
-    residual_sq: f64,
-    /// Squared residual of each group marker (NaN when absent).
+/// What an assessment reads: the sample's frames it fits (storage indices of triple centres)
+/// and the markers it measures the face by.
+pub(crate) struct Scope<'a> {
+    pub(crate) frames: &'a [usize],
+    pub(crate) others: &'a [usize],
+}
+
+/// The group's pose in every fitted frame, with the fit's residuals.
+struct Fits {
+    /// Storage index of each fitted frame.
+    frames: Vec<usize>,
+    poses: Vec<Pose>,
+    /// Mean squared residual per fitted frame.
+    residual_sq: Vec<f64>,
+    /// Squared residual of each group marker per fitted frame (NaN when absent), frame-major.
     per_marker_sq: Vec<f64>,
 }
 
-/// Assesses `group` as a head reference against the `candidates` (markers present enough);
-/// `None` when fewer than three of its markers are ever seen together or they are collinear.
+/// Assesses `group` as a head reference over `scope` (the `others`: markers present enough,
+/// the group's own left out by the caller or here); `None` when fewer than three of its
+/// markers are ever seen together or they are collinear.
 pub(crate) fn assess_group(
     sample: &Sample,
     group: &[usize],
-    candidates: &[usize],
+    scope: &Scope<'_>,
     noise_mm: f64,
 ) -> Option<GroupAssessment> {
-    let template = template(sample, group)?;
-    let others: Vec<usize> = candidates
+    let template = template(sample, group, scope.frames)?;
+    let others: Vec<usize> = scope
+        .others
         .iter()
         .copied()
         .filter(|m| !group.contains(m))
         .collect();
-    // Frames at once on the current rayon pool (in order: the result is the same).
-    let fits: Vec<(usize, Fitted)> = (0..sample.frames())
-        .into_par_iter()
-        .filter_map(|s| Some((3 * s + 1, fit(sample, group, &template, 3 * s + 1)?)))
-        .collect();
-    if fits.is_empty() {
+    let fits = fit_all(sample, group, &template, scope.frames);
+    if fits.frames.is_empty() {
         return None;
     }
-    let n = group.len() as f64;
-    let marker_residual_mm = (0..group.len())
-        .map(|k| {
+    let k = group.len();
+    let marker_residual_mm = (0..k)
+        .map(|j| {
             let (sum, count) = fits
+                .per_marker_sq
                 .iter()
-                .map(|(_, f)| f.per_marker_sq[k])
+                .skip(j)
+                .step_by(k)
                 .filter(|v| !v.is_nan())
                 .fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
             (sum / count.max(1) as f64).sqrt()
         })
         .collect();
-    let mut res: Vec<f64> = fits.iter().map(|(_, f)| f.residual_sq).collect();
+    let mut res = fits.residual_sq.clone();
     res.sort_by(f64::total_cmp);
     res.truncate(((res.len() as f64 * 0.99).ceil() as usize).max(1));
     let fre_sq = res.iter().sum::<f64>() / res.len() as f64;
-    let deformation_mm = (fre_sq / (1.0 - 2.0 / n).max(1.0 / 3.0)).sqrt();
+    let deformation_mm = (fre_sq / (1.0 - 2.0 / k as f64).max(1.0 / 3.0)).sqrt();
     let targets = head_means(sample, &fits, &others);
     let pose_error_mm = tre(&template, &targets, deformation_mm);
     let motion_mm = motion(&fits, &targets);
@@ -122,26 +133,27 @@ pub(crate) fn assess_group(
         pose_error_mm,
         leakage,
         noise_mm,
+        template,
     })
 }
 
-/// The group's shape by generalised Procrustes averaging over the sample.
-fn template(sample: &Sample, group: &[usize]) -> Option<Vec<[f64; 3]>> {
+/// The group's shape by generalised Procrustes averaging over the sample's `frames`.
+fn template(sample: &Sample, group: &[usize], frames: &[usize]) -> Option<Vec<[f64; 3]>> {
     let complete = |f: usize| group.iter().all(|&m| sample.get(f, m).is_some());
-    let first = (0..sample.frames())
-        .map(|s| 3 * s + 1)
-        .find(|&f| complete(f))?;
+    let first = frames.iter().copied().find(|&f| complete(f))?;
     let mut template: Vec<[f64; 3]> = group
         .iter()
         .map(|&m| point(sample.get(first, m).expect("complete frame"), 0).into())
         .collect();
     centre(&mut template);
+    let mut sum = vec![Vector3::<f64>::zeros(); group.len()];
+    let mut count = vec![0usize; group.len()];
+    let mut pairs = Pairs::with_capacity(group.len());
     for _ in 0..3 {
-        let mut sum = vec![Vector3::<f64>::zeros(); group.len()];
-        let mut count = vec![0usize; group.len()];
-        for s in 0..sample.frames() {
-            let f = 3 * s + 1;
-            let Some(pose) = fit(sample, group, &template, f).map(|x| x.pose) else {
+        sum.fill(Vector3::zeros());
+        count.fill(0);
+        for &f in frames {
+            let Some(pose) = fit(sample, group, &template, f, &mut pairs) else {
                 continue;
             };
             let inv = pose.rotation.transpose();
@@ -163,40 +175,67 @@ fn template(sample: &Sample, group: &[usize]) -> Option<Vec<[f64; 3]>> {
     kabsch(own).map(|_| template)
 }
 
-fn fit(sample: &Sample, group: &[usize], template: &[[f64; 3]], f: usize) -> Option<Fitted> {
-    let pairs = group
-        .iter()
-        .zip(template)
-        .filter_map(|(&m, t)| Some((t, point(sample.get(f, m)?, 0))));
-    let (pose, used) = kabsch(pairs)?;
-    let per_marker_sq: Vec<f64> = group
-        .iter()
-        .zip(template)
-        .map(|(&m, t)| match sample.get(f, m) {
-            Some(q) => {
-                (pose.rotation * Vector3::from(*t) + pose.translation - point(q, 0)).norm_squared()
-            }
-            None => f64::NAN,
-        })
-        .collect();
-    let sq: f64 = per_marker_sq.iter().filter(|v| !v.is_nan()).sum();
-    Some(Fitted {
-        pose,
-        residual_sq: sq / used as f64,
-        per_marker_sq,
-    })
+/// Template points paired with a frame's observed ones, reused across frames.
+type Pairs = Vec<([f64; 3], Vector3<f64>)>;
+
+/// The group's pose in frame `f` (a sample storage index).
+fn fit(
+    sample: &Sample,
+    group: &[usize],
+    template: &[[f64; 3]],
+    f: usize,
+    pairs: &mut Pairs,
+) -> Option<Pose> {
+    pairs.clear();
+    for (&m, t) in group.iter().zip(template) {
+        if let Some(q) = sample.get(f, m) {
+            pairs.push((*t, point(q, 0)));
+        }
+    }
+    kabsch(pairs.iter().map(|(t, q)| (t, *q))).map(|(pose, _)| pose)
+}
+
+/// Poses and residuals of the group in every one of `frames` where it can be fitted.
+fn fit_all(sample: &Sample, group: &[usize], template: &[[f64; 3]], frames: &[usize]) -> Fits {
+    let mut fits = Fits {
+        frames: Vec::with_capacity(frames.len()),
+        poses: Vec::with_capacity(frames.len()),
+        residual_sq: Vec::with_capacity(frames.len()),
+        per_marker_sq: Vec::with_capacity(frames.len() * group.len()),
+    };
+    let mut pairs = Pairs::with_capacity(group.len());
+    for &f in frames {
+        let Some(pose) = fit(sample, group, template, f, &mut pairs) else {
+            continue;
+        };
+        let (mut sq, mut used) = (0.0, 0usize);
+        for (&m, t) in group.iter().zip(template) {
+            let r = match sample.get(f, m) {
+                Some(q) => {
+                    let r = (pose.rotation * Vector3::from(*t) + pose.translation - point(q, 0))
+                        .norm_squared();
+                    (sq, used) = (sq + r, used + 1);
+                    r
+                }
+                None => f64::NAN,
+            };
+            fits.per_marker_sq.push(r);
+        }
+        fits.frames.push(f);
+        fits.poses.push(pose);
+        fits.residual_sq.push(sq / used as f64);
+    }
+    fits
 }
 
 /// Mean head-coordinate position of each other marker.
-fn head_means(sample: &Sample, fits: &[(usize, Fitted)], others: &[usize]) -> Vec<Vector3<f64>> {
-    // Markers at once on the current rayon pool, collected in order.
+fn head_means(sample: &Sample, fits: &Fits, others: &[usize]) -> Vec<Vector3<f64>> {
     others
-        .par_iter()
+        .iter()
         .filter_map(|&m| {
             let (mut sum, mut count) = (Vector3::zeros(), 0usize);
-            for (f, fitted) in fits {
-                if let Some(p) = sample.get(*f, m) {
-                    let pose = &fitted.pose;
+            for (&f, pose) in fits.frames.iter().zip(&fits.poses) {
+                if let Some(p) = sample.get(f, m) {
                     sum += pose.rotation.transpose() * (point(p, 0) - pose.translation);
                     count += 1;
                 }
@@ -239,13 +278,12 @@ fn tre(template: &[[f64; 3]], targets: &[Vector3<f64>], fle: f64) -> f64 {
 }
 
 /// RMS world motion of head-fixed points at `targets`.
-fn motion(fits: &[(usize, Fitted)], targets: &[Vector3<f64>]) -> f64 {
+fn motion(fits: &Fits, targets: &[Vector3<f64>]) -> f64 {
     let (mut sq, mut count) = (0.0, 0usize);
+    let mut world = Vec::with_capacity(fits.poses.len());
     for r in targets {
-        let world: Vec<Vector3<f64>> = fits
-            .iter()
-            .map(|(_, f)| f.pose.rotation * r + f.pose.translation)
-            .collect();
+        world.clear();
+        world.extend(fits.poses.iter().map(|p| p.rotation * r + p.translation));
         let mean = world.iter().sum::<Vector3<f64>>() / world.len() as f64;
         sq += world.iter().map(|w| (w - mean).norm_squared()).sum::<f64>();
         count += world.len();
@@ -274,22 +312,20 @@ fn pose_params(p: &Pose) -> SVector<f64, 6> {
 
 /// Median over `others` of the share of their head-coordinate variance explained linearly by
 /// the pose parameters.
-fn leakage(sample: &Sample, fits: &[(usize, Fitted)], others: &[usize]) -> f64 {
-    let params: Vec<SVector<f64, 6>> = fits.iter().map(|(_, f)| pose_params(&f.pose)).collect();
-    // Markers at once on the current rayon pool, collected in order.
+fn leakage(sample: &Sample, fits: &Fits, others: &[usize]) -> f64 {
+    let params: Vec<SVector<f64, 6>> = fits.poses.iter().map(pose_params).collect();
+    let mut rows = Vec::with_capacity(params.len());
     let mut shares: Vec<f64> = others
-        .par_iter()
+        .iter()
         .filter_map(|&m| {
-            let rows: Vec<(SVector<f64, 7>, Vector3<f64>)> = fits
-                .iter()
-                .zip(&params)
-                .filter_map(|((f, fitted), p)| {
-                    let x = point(sample.get(*f, m)?, 0);
-                    let pose = &fitted.pose;
+            rows.clear();
+            rows.extend(fits.frames.iter().zip(&fits.poses).zip(&params).filter_map(
+                |((&f, pose), p)| {
+                    let x = point(sample.get(f, m)?, 0);
                     let head = pose.rotation.transpose() * (x - pose.translation);
                     Some((p.push(1.0), head))
-                })
-                .collect();
+                },
+            ));
             explained_share(&rows)
         })
         .collect();
@@ -311,9 +347,21 @@ fn explained_share(rows: &[(SVector<f64, 7>, Vector3<f64>)]) -> Option<f64> {
         let mut xc = x - mean_x;
         xc[6] = 1.0;
         let yc = y - mean_y;
-        xtx += xc * xc.transpose();
-        xty += xc * yc.transpose();
+        // The upper triangle only (mirrored below): a third of the products.
+        for i in 0..7 {
+            for j in i..7 {
+                xtx[(i, j)] += xc[i] * xc[j];
+            }
+            for a in 0..3 {
+                xty[(i, a)] += xc[i] * yc[a];
+            }
+        }
         total += yc.norm_squared();
+    }
+    for i in 0..7 {
+        for j in 0..i {
+            xtx[(i, j)] = xtx[(j, i)];
+        }
     }
     // Scale-free ridge so degenerate pose parameters (no rotation at all) stay solvable.
     let ridge = 1e-9 * xtx.trace().max(1e-12);

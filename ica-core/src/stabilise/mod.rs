@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod assess;
+mod pairs;
 mod rotation;
 mod sample;
 pub mod search;

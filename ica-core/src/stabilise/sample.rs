@@ -4,8 +4,7 @@
 
 use std::ops::Range;
 
-use super::point;
-use crate::robust::{mad, median, quantile};
+use crate::robust::{mad, median, quantile_f32};
 
 /// Frames of a capture in one marker order: `xyz` frames x markers x 3 (mm), `missing` frames
 /// x markers, and the frame range of each take (differences never cross a take boundary).
@@ -29,6 +28,9 @@ pub(crate) struct Sample {
     present: Vec<bool>,
     markers: usize,
     pub(crate) glitches: usize,
+    /// The same positions marker by marker, axis by axis (NaN where not present): what the
+    /// loops over one marker's or one pair's frames read, contiguous so they vectorise.
+    columns: Vec<f32>,
 }
 
 /// Glitch speed: this multiple of the 99.9th percentile speed, at least [`MIN_GLITCH_MM_S`]
@@ -63,19 +65,40 @@ impl Sample {
             present,
             markers: n,
             glitches: 0,
+            columns: Vec::new(),
         };
         sample.mask_glitches();
+        sample.columns = sample.transposed();
         sample
+    }
+
+    /// [`Sample::columns`] from the frame-major storage, written column by column.
+    fn transposed(&self) -> Vec<f32> {
+        let (n, t) = (self.markers, self.present.len() / self.markers.max(1));
+        let mut columns = vec![0.0; n * 3 * t];
+        for (c, column) in columns.chunks_exact_mut(t.max(1)).enumerate() {
+            let (m, axis) = (c / 3, c % 3);
+            for (f, v) in column.iter_mut().enumerate() {
+                let i = f * n + m;
+                *v = if self.present[i] {
+                    self.xyz[i * 3 + axis]
+                } else {
+                    f32::NAN
+                };
+            }
+        }
+        columns
+    }
+
+    /// Marker `m`'s coordinate `axis` over the stored frames (3 per sample), NaN where absent.
+    pub(crate) fn column(&self, m: usize, axis: usize) -> &[f32] {
+        let t = 3 * self.frames();
+        &self.columns[(m * 3 + axis) * t..(m * 3 + axis + 1) * t]
     }
 
     /// Sampled frames (centres).
     pub(crate) fn frames(&self) -> usize {
         self.present.len() / (3 * self.markers.max(1))
-    }
-
-    /// Storage indices of sample `s`'s three frames.
-    pub(crate) fn triple(&self, s: usize) -> [usize; 3] {
-        [3 * s, 3 * s + 1, 3 * s + 2]
     }
 
     /// A present sample's x y z.
@@ -84,52 +107,55 @@ impl Sample {
         self.present[i].then(|| &self.xyz[i * 3..i * 3 + 3])
     }
 
-    fn step(&self, a: usize, b: usize, m: usize) -> Option<f64> {
-        Some((point(self.get(a, m)?, 0) - point(self.get(b, m)?, 0)).norm())
-    }
-
     /// Marks samples whose step to a neighbour is a glitch (see [`GLITCH_FACTOR`]).
     fn mask_glitches(&mut self) {
-        use rayon::prelude::*;
         // Both steps of every triple and marker (NaN where a sample is missing), measured once,
-        // triples at once on the current rayon pool and collected in order.
-        let markers = self.markers;
-        let this = &*self;
-        let both: Vec<[f64; 2]> = (0..self.frames())
-            .into_par_iter()
-            .flat_map_iter(|s| {
-                let [b, a, n] = this.triple(s);
-                (0..markers).map(move |m| {
-                    let step = |x: usize, y: usize| this.step(x, y, m).unwrap_or(f64::NAN);
-                    [step(b, a), step(a, n)]
-                })
-            })
-            .collect();
-        let mut steps: Vec<f64> = both
-            .iter()
-            .flatten()
-            .copied()
-            .filter(|v| !v.is_nan())
-            .collect();
-        let limit = (GLITCH_FACTOR * quantile(&mut steps, 0.999)).max(MIN_GLITCH_STEP_MM);
-        for s in 0..self.frames() {
-            let [b, a, n] = self.triple(s);
-            for m in 0..self.markers {
-                // NaN (missing) is never above the limit.
-                if both[s * markers + m].iter().any(|&v| v > limit) {
-                    for g in [b, a, n] {
-                        let i = g * self.markers + m;
-                        self.glitches += usize::from(self.present[i]);
-                        self.present[i] = false;
+        // in f32 (the limit is a multiple of a percentile: its last digits decide nothing).
+        let n = self.markers;
+        let frame = 3 * n;
+        let mut both = Vec::with_capacity(2 * self.present.len() / 3);
+        for (xyz, present) in self
+            .xyz
+            .chunks_exact(3 * frame.max(1))
+            .zip(self.present.chunks_exact(frame.max(1)))
+        {
+            let (b, rest) = xyz.split_at(frame);
+            let (a, after) = rest.split_at(frame);
+            for m in 0..n {
+                let step = |p: &[f32], q: &[f32], ok: bool| {
+                    let d = (p[3 * m] - q[3 * m]).powi(2)
+                        + (p[3 * m + 1] - q[3 * m + 1]).powi(2)
+                        + (p[3 * m + 2] - q[3 * m + 2]).powi(2);
+                    if ok {
+                        d.sqrt()
+                    } else {
+                        f32::NAN
                     }
+                };
+                let (pb, pa, pn) = (present[m], present[n + m], present[2 * n + m]);
+                both.push(step(b, a, pb && pa));
+                both.push(step(a, after, pa && pn));
+            }
+        }
+        let mut steps: Vec<f32> = both.iter().copied().filter(|v| !v.is_nan()).collect();
+        let limit =
+            (GLITCH_FACTOR * f64::from(quantile_f32(&mut steps, 0.999))).max(MIN_GLITCH_STEP_MM);
+        for (s, pair) in both.chunks_exact(2).enumerate() {
+            // NaN (missing) is never above the limit.
+            if pair.iter().any(|&v| f64::from(v) > limit) {
+                let (triple, m) = (s / n.max(1), s % n.max(1));
+                for g in 3 * triple..3 * triple + 3 {
+                    let i = g * n + m;
+                    self.glitches += usize::from(self.present[i]);
+                    self.present[i] = false;
                 }
             }
         }
     }
 
     pub(crate) fn present_share(&self, m: usize) -> f64 {
-        let at = (0..self.frames()).filter(|&s| self.get(3 * s + 1, m).is_some());
-        at.count() as f64 / self.frames().max(1) as f64
+        let centres = self.column(m, 0).iter().skip(1).step_by(3);
+        centres.filter(|v| !v.is_nan()).count() as f64 / self.frames().max(1) as f64
     }
 
     /// Median over `markers` and axes of the robust spread of second differences / √6.
@@ -152,12 +178,11 @@ impl Sample {
     /// 10 of them (`d2` is scratch).
     fn axis_noise(&self, m: usize, axis: usize, d2: &mut Vec<f64>) -> Option<f64> {
         d2.clear();
-        for s in 0..self.frames() {
-            let [b, a, n] = self.triple(s);
-            if let (Some(p), Some(q), Some(r)) = (self.get(b, m), self.get(a, m), self.get(n, m)) {
-                d2.push(f64::from(p[axis]) - 2.0 * f64::from(q[axis]) + f64::from(r[axis]));
-            }
-        }
+        let column = self.column(m, axis);
+        d2.extend(column.chunks_exact(3).filter_map(|t| {
+            let v = f64::from(t[0]) - 2.0 * f64::from(t[1]) + f64::from(t[2]);
+            v.is_finite().then_some(v)
+        }));
         (d2.len() >= 10).then(|| mad(d2) / 6f64.sqrt())
     }
 }

@@ -8,21 +8,36 @@
 //! 2. **Noise.** The capture's own per-coordinate noise `σ`: the median over markers and axes
 //!    of the robust spread of second differences, `1.4826 · MAD(x[t−1] − 2x[t] + x[t+1]) / √6`.
 //! 3. **Pairs.** For every pair, its distance's robust spread beyond noise (the *excess*,
-//!    `√(spread² − noise²)`), relative to its length (the *strain*). Optical systems measure a
+//!    `√(spread² − noise²)`), relative to its length (the *strain*), over
+//!    [`PAIR_SAMPLES`] of the sampled triples. Optical systems measure a
 //!    face-sized distance to better than [`RIGID_STRAIN`] (1 %); skin moves by several per cent
 //!    (a brow raise stretches the forehead by 5-10 %, speech moves the jaw by 20 %).
 //! 4. **Groups.** Candidate groups: every maximal set grown greedily from the most rigid pairs
 //!    whose pairs all stay within the strain limit, and the greedy least-deforming set.
 //! 5. **Assess** each candidate (`assess`): deformation, pose error at the face, head
-//!    motion, and how much of its motion the face would inherit.
+//!    motion, and how much of its motion the face would inherit. Pruned first: every group
+//!    (and its core) is assessed coarsely on [`COARSE_ASSESS_FRAMES`] frames against
+//!    [`COARSE_ASSESS_OTHERS`] face markers, and only those [`choose`] could pick, with a
+//!    margin, are assessed on the whole sample (at most [`SHORTLIST`] and the least leaking).
 //!
 //! [`choose`] then picks, among the candidates least tied to the face, the one with the
 //! smallest pose error at the face.
+//!
+//! **Cost.** Bounded by the sample, whatever the session's length: at 109 markers, 5,886 pairs
+//! and some 50 groups, a few tens of milliseconds on two cores (2.6 s before the pair table
+//! was measured on a thin sample and the groups pruned; see `pairs` for why every pair is
+//! measured). The decisions are those of every pair and group measured on 2,000 frames: the
+//! same reference on Facial-Sing (its six root markers), AnimFace and the generator's head
+//! bands, the same verdict on a still head (whose most head-like group, only named in the
+//! report, may differ by a marker).
 
-use super::assess::{assess_group, GroupAssessment};
-use super::point;
+use rayon::prelude::*;
+
+use super::assess::{assess_group, GroupAssessment, Scope};
+use super::pairs::PairTable;
+pub use super::pairs::PAIR_SAMPLES;
 use super::sample::{MarkerFrames, Sample};
-use crate::robust::{mad, median};
+use crate::robust::median;
 
 pub use super::assess::{MIN_MOTION_MM, MOTION_FACTOR, RIGID_NOISE_FACTOR};
 
@@ -40,7 +55,7 @@ pub const LEAKAGE_TOLERANCE: f64 = 0.05;
 /// Knobs of [`search_reference`]; the defaults are the documented constants.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SearchParams {
-    /// Frames sampled at most.
+    /// Frames sampled at most (each with its two neighbours).
     pub max_frames: usize,
     /// Markers present in fewer than this share of the sampled frames are not candidates.
     pub min_present: f64,
@@ -55,7 +70,7 @@ pub struct SearchParams {
 impl Default for SearchParams {
     fn default() -> SearchParams {
         SearchParams {
-            max_frames: 2000,
+            max_frames: 1000,
             min_present: 0.8,
             rigid_strain: RIGID_STRAIN,
             max_groups: 40,
@@ -141,19 +156,16 @@ pub fn search_reference(frames: &MarkerFrames<'_>, params: &SearchParams) -> Ref
     if ld.len() >= 3 && !groups.contains(&ld) {
         groups.push(ld);
     }
-    let mut candidates: Vec<GroupAssessment> = Vec::new();
-    for group in &groups {
-        let Some(a) = assess_group(&sample, group, &candidates_markers, noise_mm) else {
-            continue;
-        };
-        // A group grown to one marker too many (a face marker that barely moves relative to
-        // the band) is assessed without its outliers too.
-        let core = core_of(&a);
-        candidates.push(a);
-        if core.len() >= 3 && core.len() < group.len() && !groups.contains(&core) {
-            candidates.extend(assess_group(&sample, &core, &candidates_markers, noise_mm));
-        }
-    }
+    let all_frames: Vec<usize> = (0..sample.frames()).map(|s| 3 * s + 1).collect();
+    let full = Scope {
+        frames: &all_frames,
+        others: &candidates_markers,
+    };
+    let shortlist = shortlist(&sample, &groups, &candidates_markers, noise_mm);
+    let mut candidates: Vec<GroupAssessment> = shortlist
+        .par_iter()
+        .filter_map(|group| assess_group(&sample, group, &full, noise_mm))
+        .collect();
     candidates.sort_by(|a, b| a.leakage.total_cmp(&b.leakage));
     ReferenceSearch {
         noise_mm,
@@ -161,6 +173,89 @@ pub fn search_reference(frames: &MarkerFrames<'_>, params: &SearchParams) -> Ref
         glitches: sample.glitches,
         candidates,
     }
+}
+
+/// Frames of the sample the first, coarse assessment of every group fits.
+pub const COARSE_ASSESS_FRAMES: usize = 128;
+/// Other markers the coarse assessment measures the face by (evenly among the candidates).
+pub const COARSE_ASSESS_OTHERS: usize = 32;
+/// Groups assessed in full: the coarsely assessed ones [`choose`] could pick, by pose error.
+pub const SHORTLIST: usize = 4;
+
+/// The groups worth a full assessment. Every group (and its core, see [`core_of`]) is first
+/// assessed on [`COARSE_ASSESS_FRAMES`] frames against [`COARSE_ASSESS_OTHERS`] markers;
+/// those [`choose`] could pick with some margin on the leakage (its window widened by a
+/// quarter and 0.02, the face limit by 0.05) go on, the [`SHORTLIST`] of least pose error and
+/// always the least leaking one.
+fn shortlist(
+    sample: &Sample,
+    groups: &[Vec<usize>],
+    candidates: &[usize],
+    noise_mm: f64,
+) -> Vec<Vec<usize>> {
+    let every = sample.frames().div_ceil(COARSE_ASSESS_FRAMES).max(1);
+    let frames: Vec<usize> = (0..sample.frames())
+        .step_by(every)
+        .map(|s| 3 * s + 1)
+        .collect();
+    let coarse = |group: &Vec<usize>| {
+        let others: Vec<usize> = candidates
+            .iter()
+            .copied()
+            .filter(|m| !group.contains(m))
+            .collect();
+        let stride = others.len().div_ceil(COARSE_ASSESS_OTHERS).max(1);
+        let others: Vec<usize> = others.into_iter().step_by(stride).collect();
+        let scope = Scope {
+            frames: &frames,
+            others: &others,
+        };
+        assess_group(sample, group, &scope, noise_mm)
+    };
+    let mut assessed: Vec<GroupAssessment> = groups.par_iter().filter_map(coarse).collect();
+    // A group grown to one marker too many (a face marker that barely moves relative to the
+    // band) is assessed without its outliers too.
+    let cores: Vec<Vec<usize>> = assessed
+        .iter()
+        .map(core_of)
+        .filter(|core| core.len() >= 3 && !groups.contains(core))
+        .collect();
+    let mut seen: Vec<&Vec<usize>> = Vec::new();
+    let cores: Vec<&Vec<usize>> = cores
+        .iter()
+        .filter(|c| {
+            let new = !seen.contains(c) && assessed.iter().all(|a| &a.markers != *c);
+            if new {
+                seen.push(c);
+            }
+            new
+        })
+        .collect();
+    assessed.extend(cores.into_par_iter().filter_map(coarse).collect::<Vec<_>>());
+    let least = assessed
+        .iter()
+        .map(|c| c.leakage)
+        .fold(f64::INFINITY, f64::min);
+    let window = 1.25 * (2.0 * least).max(least + LEAKAGE_TOLERANCE) + 0.02;
+    let mut eligible: Vec<&GroupAssessment> = assessed
+        .iter()
+        .filter(|c| c.leakage < FACE_LEAKAGE + 0.05 && c.leakage <= window)
+        .collect();
+    eligible.sort_by(|a, b| a.pose_error_mm.total_cmp(&b.pose_error_mm));
+    let mut chosen: Vec<Vec<usize>> = eligible
+        .iter()
+        .take(SHORTLIST)
+        .map(|a| a.markers.clone())
+        .collect();
+    if let Some(a) = assessed
+        .iter()
+        .min_by(|a, b| a.leakage.total_cmp(&b.leakage))
+    {
+        if !chosen.contains(&a.markers) {
+            chosen.push(a.markers.clone());
+        }
+    }
+    chosen
 }
 
 /// A marker fitting its group's template worse than this many times the group's median is an
@@ -186,85 +281,12 @@ pub fn assess_named(frames: &MarkerFrames<'_>, markers: &[usize]) -> Option<Grou
         .filter(|&m| sample.present_share(m) > 0.0)
         .collect();
     let noise_mm = sample.noise_mm(&all);
-    assess_group(&sample, markers, &all, noise_mm)
-}
-
-/// Excess strain of every candidate pair (∞ where too few samples overlap).
-struct PairTable {
-    markers: Vec<usize>,
-    strain: Vec<f64>,
-}
-
-impl PairTable {
-    fn measure(sample: &Sample, markers: &[usize]) -> PairTable {
-        let k = markers.len();
-        let mut strain = vec![f64::INFINITY; k * k];
-        let mut d = Vec::with_capacity(sample.frames());
-        let mut d2 = Vec::with_capacity(sample.frames());
-        for i in 0..k {
-            for j in i + 1..k {
-                let (a, b) = (markers[i], markers[j]);
-                d.clear();
-                d2.clear();
-                for s in 0..sample.frames() {
-                    let dist = |f: usize| -> Option<f64> {
-                        let (pa, pb) = (sample.get(f, a)?, sample.get(f, b)?);
-                        Some((point(pa, 0) - point(pb, 0)).norm())
-                    };
-                    let [before, at, after] = sample.triple(s);
-                    if let Some(x) = dist(at) {
-                        d.push(x);
-                        if let (Some(p), Some(n)) = (dist(before), dist(after)) {
-                            d2.push(p - 2.0 * x + n);
-                        }
-                    }
-                }
-                if d.len() < 10 || d2.len() < 10 {
-                    continue;
-                }
-                let length = median(&mut d);
-                let spread = mad(&mut d);
-                let noise = mad(&mut d2) / 6f64.sqrt();
-                let excess = (spread * spread - noise * noise).max(0.0).sqrt();
-                let s = excess / length.max(1e-6);
-                strain[i * k + j] = s;
-                strain[j * k + i] = s;
-            }
-        }
-        PairTable {
-            markers: markers.to_vec(),
-            strain,
-        }
-    }
-
-    fn len(&self) -> usize {
-        self.markers.len()
-    }
-
-    fn strain(&self, i: usize, j: usize) -> f64 {
-        self.strain[i * self.len() + j]
-    }
-
-    /// Pairs (i < j) by increasing strain.
-    fn sorted_pairs(&self) -> Vec<(usize, usize)> {
-        let k = self.len();
-        let mut pairs: Vec<(usize, usize)> = (0..k)
-            .flat_map(|i| (i + 1..k).map(move |j| (i, j)))
-            .filter(|&(i, j)| self.strain(i, j).is_finite())
-            .collect();
-        pairs.sort_by(|a, b| self.strain(a.0, a.1).total_cmp(&self.strain(b.0, b.1)));
-        pairs
-    }
-
-    fn mean_strain(&self, c: usize, group: &[usize]) -> f64 {
-        group.iter().map(|&g| self.strain(c, g)).sum::<f64>() / group.len() as f64
-    }
-
-    fn to_markers(&self, group: &[usize]) -> Vec<usize> {
-        let mut out: Vec<usize> = group.iter().map(|&g| self.markers[g]).collect();
-        out.sort_unstable();
-        out
-    }
+    let all_frames: Vec<usize> = (0..sample.frames()).map(|s| 3 * s + 1).collect();
+    let scope = Scope {
+        frames: &all_frames,
+        others: &all,
+    };
+    assess_group(&sample, markers, &scope, noise_mm)
 }
 
 /// Maximal groups within `limit`, each grown from one of the most rigid pairs by

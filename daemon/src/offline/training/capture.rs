@@ -37,8 +37,9 @@ pub(super) fn learn(
     options: &PrepOptions,
 ) -> Result<Learned> {
     let n = labels.len();
-    // 1. The head: decided on the raw frames, template from them (its Procrustes mean shrugs
-    //    off rare glitches).
+    // 1. The head: decided on the raw frames, its template the decision's own Procrustes mean
+    //    over the sample it assessed the reference on (it shrugs off rare glitches, and the
+    //    sample's glitches are masked).
     let (raw_xyz, raw_missing, ranges) = concatenated(frames, n);
     let raw = MarkerFrames {
         xyz: &raw_xyz,
@@ -47,16 +48,19 @@ pub(super) fn learn(
         takes: &ranges,
     };
     let decision = head::decide(&options.head, labels, excluded, &raw)?;
+    drop((raw_xyz, raw_missing));
     let reference = decision.markers;
     let head = match reference.len() {
         0 => None,
         _ => Some(
-            Stabiliser::fit(&raw_xyz, &raw_missing, n, reference.clone())?
-                .reference()
-                .clone(),
+            Stabiliser::new(HeadReference {
+                markers: reference.clone(),
+                template: decision.template,
+            })?
+            .reference()
+            .clone(),
         ),
     };
-    drop((raw_xyz, raw_missing));
     let mut capture = CaptureSettings {
         head,
         max_speed_mm_s: None,

@@ -57,13 +57,36 @@ impl HeadChoice {
     }
 }
 
-/// The decision: reference markers (empty: no stabilisation) and the report.
+/// The decision: reference markers (empty: no stabilisation), their template and the report.
 #[derive(Debug, Clone)]
 pub struct HeadDecision {
     /// Marker indices to stabilise on; empty when not stabilising.
     pub markers: Vec<usize>,
+    /// The reference's shape (centred, mm, in `markers` order) as the decision's own
+    /// Procrustes fit over its sample found it; empty when not stabilising.
+    pub template: Vec<[f64; 3]>,
     /// What was decided and why.
     pub report: HeadReport,
+}
+
+impl HeadDecision {
+    /// Not stabilising, for this reason.
+    fn none(report: HeadReport) -> HeadDecision {
+        HeadDecision {
+            markers: Vec::new(),
+            template: Vec::new(),
+            report,
+        }
+    }
+
+    /// Stabilising on an assessed group.
+    fn on(a: GroupAssessment, report: HeadReport) -> HeadDecision {
+        HeadDecision {
+            markers: a.markers,
+            template: a.template,
+            report,
+        }
+    }
 }
 
 /// Decides the head reference among the kept markers `labels` (`excluded`: the markers left
@@ -79,14 +102,11 @@ pub fn decide(
     frames: &MarkerFrames<'_>,
 ) -> Result<HeadDecision> {
     match choice {
-        HeadChoice::None => Ok(HeadDecision {
-            markers: Vec::new(),
-            report: HeadReport {
-                source: "none".into(),
-                verdict: "head stabilisation off (--head-reference none)".into(),
-                ..HeadReport::default()
-            },
-        }),
+        HeadChoice::None => Ok(HeadDecision::none(HeadReport {
+            source: "none".into(),
+            verdict: "head stabilisation off (--head-reference none)".into(),
+            ..HeadReport::default()
+        })),
         HeadChoice::Labels {
             patterns,
             requested,
@@ -195,14 +215,10 @@ fn from_named(
     };
     let Some(a) = assess_named(frames, &markers) else {
         // Never three of them together: stabilisation would hold one pose forever.
-        return HeadDecision {
-            markers: Vec::new(),
-            report: HeadReport {
-                verdict: "not stabilised: the reference markers are never seen three at a time"
-                    .into(),
-                ..report
-            },
-        };
+        return HeadDecision::none(HeadReport {
+            verdict: "not stabilised: the reference markers are never seen three at a time".into(),
+            ..report
+        });
     };
     let mut report = with_numbers(report, &a);
     if !a.motion_is_measurable() {
@@ -218,17 +234,14 @@ fn from_named(
             )
         };
         report.verdict = format!("not stabilised: {why}");
-        return HeadDecision {
-            markers: Vec::new(),
-            report,
-        };
+        return HeadDecision::none(report);
     }
     report.stabilised = true;
     report.verdict = format!(
         "stabilised on the {source} markers: head motion {:.2} mm RMS, the reference deforms by {:.2} mm, pose error at the face {:.2} mm",
         a.motion_mm, a.deformation_mm, a.pose_error_mm
     );
-    HeadDecision { markers, report }
+    HeadDecision::on(a, report)
 }
 
 fn from_geometry(labels: &[String], frames: &MarkerFrames<'_>) -> HeadDecision {
@@ -250,10 +263,7 @@ fn from_geometry(labels: &[String], frames: &MarkerFrames<'_>) -> HeadDecision {
                 a.motion_mm,
                 a.pose_error_mm
             );
-            HeadDecision {
-                markers: Vec::new(),
-                report,
-            }
+            HeadDecision::none(report)
         }
         Choice::MovesWithFace(a) => {
             let mut report = with_numbers(base, &a);
@@ -263,18 +273,12 @@ fn from_geometry(labels: &[String], frames: &MarkerFrames<'_>) -> HeadDecision {
                 report.markers.join(", "),
                 100.0 * a.leakage
             );
-            HeadDecision {
-                markers: Vec::new(),
-                report,
-            }
+            HeadDecision::none(report)
         }
-        Choice::NoCandidate => HeadDecision {
-            markers: Vec::new(),
-            report: HeadReport {
-                verdict: "not stabilised: fewer than three markers are present often enough".into(),
-                ..base
-            },
-        },
+        Choice::NoCandidate => HeadDecision::none(HeadReport {
+            verdict: "not stabilised: fewer than three markers are present often enough".into(),
+            ..base
+        }),
     }
 }
 
@@ -294,8 +298,5 @@ fn stabilised_on_found(base: HeadReport, a: GroupAssessment, labels: &[String]) 
             a.noise_mm, a.deformation_mm, a.pose_error_mm, a.motion_mm
         )
     };
-    HeadDecision {
-        markers: a.markers,
-        report,
-    }
+    HeadDecision::on(a, report)
 }
