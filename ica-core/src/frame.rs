@@ -146,6 +146,13 @@ impl FrameEdit {
                 got: u.len(),
             });
         }
+        self.apply_sized(u);
+        Ok(())
+    }
+
+    /// [`FrameEdit::apply`] on `u` of the edit's length (shorter or longer: the common part).
+    #[inline(always)]
+    pub(crate) fn apply_sized(&self, u: &mut [f32]) {
         for ((ui, g), o) in u.iter_mut().zip(&self.gains).zip(&self.offsets) {
             *ui = *ui * g + o;
         }
@@ -154,7 +161,6 @@ impl FrameEdit {
                 *ui = *v;
             }
         }
-        Ok(())
     }
 
     fn check(&self, k: usize, what: &'static str, value: f32) -> Result<(), EditError> {
