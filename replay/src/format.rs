@@ -10,7 +10,8 @@ use crate::{c3d, csv, trc, Take};
 /// The take formats emoshift reads and writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
-    /// C3D (read through c3dio, written by [`crate::c3d::write`] as Intel float32).
+    /// C3D (read by emoshift's decoder, cross-checked by c3dio; written by [`crate::c3d::write`]
+    /// as Intel float32).
     C3d,
     /// TRC, the OpenSim / Motion Analysis text layout.
     Trc,
@@ -65,11 +66,11 @@ pub fn load_limited(path: &Path, max_bytes: u64) -> Result<Take, ReadError> {
 /// How [`load_with`] decodes the points of a C3D file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum C3dDecoding {
-    /// Through c3dio, checked against emoshift's own decoder ([`c3d::read`]).
+    /// emoshift's own decoder, cross-checked by c3dio on a sample of frames ([`c3d::read`]).
     #[default]
     CrossChecked,
-    /// emoshift's own decoder alone ([`c3d::read_own`]): the same take, in a fifth of the
-    /// decoding time.
+    /// emoshift's own decoder alone ([`c3d::read_own`]): the same take, without the
+    /// cross-check.
     Own,
 }
 

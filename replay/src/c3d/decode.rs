@@ -1,5 +1,5 @@
-//! The 3D samples: decoded by c3dio where it can, by our own decoder otherwise, and the missing
-//! mask from the raw residual words either way.
+//! The 3D samples: decoded by our own decoder, cross-checked by c3dio on a sample of frames,
+//! and the missing mask from the raw residual words.
 
 use std::cell::Cell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -9,12 +9,14 @@ use c3dio::C3d;
 use super::binary::{take2, take4, Header, Processor, BLOCK};
 use super::layout::Layout;
 
-/// Which decoder produced the sample values.
+/// Who vouches for the sample values, which emoshift's own decoder produces either way.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Decoder {
-    /// The c3dio crate.
+    /// The c3dio crate read the same values on a sample of frames (up to 256, spread over
+    /// the take).
     C3dio,
-    /// emoshift's own decoder, used when c3dio refuses, panics or returns the wrong shape.
+    /// emoshift's own decoder alone: c3dio refused, panicked, returned the wrong shape or
+    /// disagreed.
     Fallback,
 }
 
@@ -46,6 +48,24 @@ pub fn own(bytes: &[u8], l: &Layout) -> Samples {
 /// its xyz (file units) and residual signs: the one per-frame decoder of both the whole-file
 /// and the frame-block readers. Bytes past the end of `frame` read as an invalid zero sample.
 pub fn frame_into(frame: &[u8], l: &Layout, xyz: &mut Vec<f32>, invalid: &mut Vec<bool>) {
+    // Intel float32, the common case: four little-endian floats per point, read without the
+    // per-value checks of the general decoder below (which gives the same values).
+    if l.float && l.processor == super::binary::Processor::Intel {
+        if let Some(points) = frame.get(..l.points * 16) {
+            let (x0, i0) = (xyz.len(), invalid.len());
+            xyz.resize(x0 + 3 * l.points, 0.0);
+            invalid.resize(i0 + l.points, false);
+            let out = xyz[x0..].chunks_exact_mut(3).zip(&mut invalid[i0..]);
+            for (p, (o, bad)) in points.chunks_exact(16).zip(out) {
+                let v = |k: usize| {
+                    f32::from_le_bytes([p[4 * k], p[4 * k + 1], p[4 * k + 2], p[4 * k + 3]])
+                };
+                o.copy_from_slice(&[v(0), v(1), v(2)]);
+                *bad = (v(3) as i32) < 0;
+            }
+            return;
+        }
+    }
     let word = l.word();
     for m in 0..l.points {
         let at = m * 4 * word;
@@ -85,11 +105,34 @@ pub fn catching_c3dio_panic() -> bool {
     CATCHING.with(Cell::get)
 }
 
-/// Decodes through c3dio: `Ok` with the values when c3dio reads the file with the expected shape,
-/// `Err` with c3dio's complaint otherwise (a panic inside c3dio included). Residual signs are not
-/// taken from c3dio: it reads the residual byte as signed, which flags large valid residuals as
-/// invalid, so the caller keeps the raw words' signs.
-pub fn via_c3dio(bytes: &[u8], l: &Layout, h: &Header) -> Result<Vec<f32>, String> {
+/// Frames the c3dio cross-check reads: every frame of a take this short, else this many spread
+/// evenly from the first frame to the last. A misread layout (a wrong frame length, word size or
+/// byte order) shows within the first frames; the spread also covers the file's end.
+pub const CHECKED_FRAMES: usize = 256;
+
+/// The frame indices the c3dio cross-check reads out of `frames`, ascending, first and last
+/// included.
+pub fn checked_frames(frames: usize) -> Vec<usize> {
+    if frames <= CHECKED_FRAMES {
+        return (0..frames).collect();
+    }
+    let span = frames - 1;
+    (0..CHECKED_FRAMES)
+        .map(|k| k * span / (CHECKED_FRAMES - 1))
+        .collect()
+}
+
+/// Decodes the frames `sample` (indices from [`checked_frames`]) through c3dio: `Ok` with their
+/// values (sample x points x 3) when c3dio reads them with the expected shape, `Err` with
+/// c3dio's complaint otherwise (a panic inside c3dio included). c3dio parses a copy of the file
+/// that holds only those frames' records (and zero padding to a whole block). Residual signs are not taken from c3dio: it reads the
+/// residual byte as signed, which flags large valid residuals as invalid.
+pub fn via_c3dio(
+    bytes: &[u8],
+    l: &Layout,
+    h: &Header,
+    sample: &[usize],
+) -> Result<Vec<f32>, String> {
     // c3dio allocates a grid of the header's frame range x points before reading any data; an
     // out-of-memory abort cannot be caught, so a range the file cannot hold never reaches it.
     let header_frames = usize::from(h.last_frame.saturating_sub(h.first_frame)) + 1;
@@ -99,8 +142,7 @@ pub fn via_c3dio(bytes: &[u8], l: &Layout, h: &Header) -> Result<Vec<f32>, Strin
             h.first_frame, h.last_frame
         ));
     }
-    let param_block = h.parameter_block;
-    let canonical = canonical_layout(bytes, l, param_block)?;
+    let canonical = canonical_layout(bytes, l, h, sample)?;
     CATCHING.with(|c| c.set(true));
     let parsed = catch_unwind(AssertUnwindSafe(|| {
         C3d::from_bytes(&canonical).map_err(|e| format!("{e:?}"))
@@ -108,17 +150,18 @@ pub fn via_c3dio(bytes: &[u8], l: &Layout, h: &Header) -> Result<Vec<f32>, Strin
     CATCHING.with(|c| c.set(false));
     let parsed = parsed.map_err(|_| "c3dio panicked".to_string())??;
     let pts = &parsed.points;
-    if pts.cols() != l.points || pts.rows() != l.frames {
+    // The copy's last block is padded with zeros, which c3dio may read as further frames.
+    if pts.cols() != l.points || pts.rows() < sample.len() {
         return Err(format!(
             "c3dio read {} points x {} frames, expected {} x {}",
             pts.cols(),
             pts.rows(),
             l.points,
-            l.frames
+            sample.len()
         ));
     }
-    let mut xyz = Vec::with_capacity(l.points * l.frames * 3);
-    for f in 0..l.frames {
+    let mut xyz = Vec::with_capacity(l.points * sample.len() * 3);
+    for f in 0..sample.len() {
         for m in 0..l.points {
             xyz.extend_from_slice(&pts[f][m].point);
         }
@@ -126,25 +169,27 @@ pub fn via_c3dio(bytes: &[u8], l: &Layout, h: &Header) -> Result<Vec<f32>, Strin
     Ok(xyz)
 }
 
-/// Checks c3dio's values against our own decoding of the same bytes, over valid samples: a
-/// difference beyond float rounding means one of the two misread the layout, and ours is the one
-/// whose every step is checked against the header.
-pub fn agree(c3dio: &[f32], own: &Samples, l: &Layout) -> Result<(), String> {
-    for (i, &bad) in own.invalid.iter().enumerate() {
-        if bad {
-            continue;
-        }
-        let pairs = c3dio[i * 3..i * 3 + 3]
-            .iter()
-            .zip(&own.xyz[i * 3..i * 3 + 3]);
-        for (&a, &b) in pairs {
-            let both_nan = a.is_nan() && b.is_nan();
-            if !both_nan && (a - b).abs() > 1e-4 * b.abs().max(1.0) {
-                return Err(format!(
-                    "c3dio reads {a} where the raw data holds {b} (frame index {}, point {})",
-                    i / l.points,
-                    i % l.points
-                ));
+/// Checks c3dio's values of the frames `sample` against our own decoding of the same bytes,
+/// over valid samples: a difference beyond float rounding means one of the two misread the
+/// layout, and ours is the one whose every step is checked against the header.
+pub fn agree(c3dio: &[f32], own: &Samples, l: &Layout, sample: &[usize]) -> Result<(), String> {
+    let n = l.points;
+    for (k, &f) in sample.iter().enumerate() {
+        for m in 0..n {
+            let (i, j) = (f * n + m, k * n + m);
+            if own.invalid[i] {
+                continue;
+            }
+            let pairs = c3dio[j * 3..j * 3 + 3]
+                .iter()
+                .zip(&own.xyz[i * 3..i * 3 + 3]);
+            for (&a, &b) in pairs {
+                let both_nan = a.is_nan() && b.is_nan();
+                if !both_nan && (a - b).abs() > 1e-4 * b.abs().max(1.0) {
+                    return Err(format!(
+                        "c3dio reads {a} where the raw data holds {b} (frame index {f}, point {m})"
+                    ));
+                }
             }
         }
     }
@@ -152,31 +197,45 @@ pub fn agree(c3dio: &[f32], own: &Samples, l: &Layout) -> Result<(), String> {
 }
 
 /// c3dio assumes the parameters start at block 2 and run to the data; files that moved them
-/// elsewhere (legal: the header points at both) are rebuilt as header, parameters, data.
-fn canonical_layout(bytes: &[u8], l: &Layout, param_block: usize) -> Result<Vec<u8>, String> {
-    let p_start = (param_block - 1) * BLOCK;
+/// elsewhere (legal: the header points at both) are rebuilt as header, parameters, data. The
+/// copy holds only the records of the frames `sample`, and its header's frame range says so.
+fn canonical_layout(
+    bytes: &[u8],
+    l: &Layout,
+    h: &Header,
+    sample: &[usize],
+) -> Result<Vec<u8>, String> {
+    let p_start = (h.parameter_block - 1) * BLOCK;
     let declared = usize::from(bytes[p_start + 2]).max(1);
     let p_end = (p_start + declared * BLOCK).min(bytes.len());
-    let data_end = l.data_offset + l.frames * l.frame_bytes();
+    let record = l.frame_bytes();
+    let data_end = l.data_offset + l.frames * record;
     let params = bytes
         .get(p_start..p_end)
         .ok_or("parameter blocks outside the file")?;
-    let data = bytes.get(l.data_offset..).ok_or("data outside the file")?;
     if data_end > bytes.len() {
         return Err("data outside the file".into());
     }
     let blocks = params.len().div_ceil(BLOCK);
     let data_block = u16::try_from(2 + blocks).map_err(|_| "too many parameter blocks")?;
-    let mut out = Vec::with_capacity(BLOCK * (1 + blocks) + data.len());
+    let mut out = Vec::with_capacity(BLOCK * (1 + blocks) + sample.len() * record);
     out.extend_from_slice(&bytes[..BLOCK]);
     out[0] = 2;
-    let word = match l.processor {
-        Processor::Mips => data_block.to_be_bytes(),
-        Processor::Intel | Processor::Dec => data_block.to_le_bytes(),
+    let last = u16::try_from(sample.len().saturating_sub(1))
+        .map_or(u16::MAX, |k| h.first_frame.saturating_add(k));
+    let word = |v: u16| match l.processor {
+        Processor::Mips => v.to_be_bytes(),
+        Processor::Intel | Processor::Dec => v.to_le_bytes(),
     };
-    out[16..18].copy_from_slice(&word);
+    out[8..10].copy_from_slice(&word(last));
+    out[16..18].copy_from_slice(&word(data_block));
     out.extend_from_slice(params);
     out.resize(BLOCK * (1 + blocks), 0);
-    out.extend_from_slice(data);
+    for &f in sample {
+        let at = l.data_offset + f * record;
+        out.extend_from_slice(&bytes[at..at + record]);
+    }
+    // c3dio wants whole blocks.
+    out.resize(out.len().next_multiple_of(BLOCK), 0);
     Ok(out)
 }

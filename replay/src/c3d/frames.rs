@@ -21,8 +21,8 @@ pub struct C3dBlocks<R> {
     input: Chain<Cursor<Vec<u8>>, R>,
     layout: Layout,
     header: TakeHeader,
-    /// One frame record, reused.
-    record: Vec<u8>,
+    /// One block's frame records, reused.
+    records: Vec<u8>,
     /// One block's raw samples, reused.
     xyz: Vec<f32>,
     invalid: Vec<bool>,
@@ -113,7 +113,7 @@ impl<R: BufRead> C3dBlocks<R> {
         };
         Ok(C3dBlocks {
             input: Cursor::new(prefix).chain(input),
-            record: vec![0; layout.frame_bytes()],
+            records: Vec::new(),
             header,
             layout,
             xyz: Vec::new(),
@@ -138,16 +138,22 @@ impl<R: BufRead> C3dBlocks<R> {
         let count = max_frames.min(self.layout.frames - self.next);
         self.xyz.clear();
         self.invalid.clear();
-        for _ in 0..count {
-            if let Err(e) = self.input.read_exact(&mut self.record) {
-                return Err(match e.kind() {
-                    std::io::ErrorKind::UnexpectedEof => truncated(&self.layout, self.next),
-                    _ => e.into(),
-                });
+        // The block's records in one read (as many reads as the input needs to fill it).
+        let record = self.layout.frame_bytes();
+        self.records.resize(count * record, 0);
+        let mut filled = 0;
+        while filled < self.records.len() {
+            match self.input.read(&mut self.records[filled..]) {
+                Ok(0) => return Err(truncated(&self.layout, self.next + filled / record)),
+                Ok(n) => filled += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(e.into()),
             }
-            decode::frame_into(&self.record, &self.layout, &mut self.xyz, &mut self.invalid);
-            self.next += 1;
         }
+        for frame in self.records.chunks_exact(record.max(1)) {
+            decode::frame_into(frame, &self.layout, &mut self.xyz, &mut self.invalid);
+        }
+        self.next += count;
         super::push_samples(&self.layout, &self.xyz, &self.invalid, block);
         Ok(count)
     }

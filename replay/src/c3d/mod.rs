@@ -1,13 +1,15 @@
-//! C3D takes: read through the `c3dio` crate with our own validation and a fallback decoder,
-//! written by our own Intel float32 writer.
+//! C3D takes: decoded once by emoshift's own decoder, cross-checked against the `c3dio` crate
+//! on a sample of frames, written by our own Intel float32 writer.
 //!
 //! Reading checks what c3dio does not: the header's frame range against POINT:FRAMES and the
 //! file length, POINT:USED against the header, the units (m and cm become mm). A sample is
 //! missing when its xyz is exactly (0, 0, 0) or its residual word is negative; the sign is taken
-//! from the raw word because c3dio reads the residual byte as signed. When c3dio refuses a file
-//! (e.g. ANALOG:OFFSET stored as float), panics, or sees no points (a header-only file with an
-//! empty parameter section), the points are decoded by our own parser from the header and
-//! whatever parameters there are, with generated labels `M001`, `M002`... where none are stored.
+//! from the raw word because c3dio reads the residual byte as signed. c3dio reads a copy of the
+//! file holding up to 256 frames spread evenly over the take, first and last included; its values
+//! must agree with ours there. When c3dio refuses a file (e.g. ANALOG:OFFSET stored as float),
+//! panics, sees no points (a header-only file with an empty parameter section) or disagrees, the
+//! take is still our decoding, and [`C3dInfo`] says why c3dio did not confirm it. Labels come
+//! from the parameters, generated as `M001`, `M002`... where none are stored.
 //!
 //! Writing produces what strict readers (ezc3d, py-c3d) accept: see [`write()`].
 
@@ -37,9 +39,9 @@ pub struct C3dInfo {
     pub processor: Processor,
     /// Whether points were stored as float32 (otherwise scaled int16).
     pub float: bool,
-    /// Which decoder produced the values.
+    /// Whether c3dio confirmed the values on a sample of frames.
     pub decoder: Decoder,
-    /// Why c3dio was not used, when it was not.
+    /// Why c3dio did not confirm them, when it did not.
     pub c3dio_error: Option<String>,
     /// Inconsistencies the file has but that did not stop reading.
     pub warnings: Vec<C3dError>,
@@ -124,13 +126,14 @@ pub fn analog_per_frame(head: &[u8]) -> Result<usize, C3dError> {
 pub fn read_with_info(bytes: &[u8]) -> Result<(Take, C3dInfo), ReadError> {
     let (processor, header, layout) = parse_layout(bytes)?;
     let own = decode::own(bytes, &layout);
-    let c3dio = decode::via_c3dio(bytes, &layout, &header)
-        .and_then(|xyz| decode::agree(&xyz, &own, &layout).map(|()| xyz));
-    let (xyz, decoder, c3dio_error) = match c3dio {
-        Ok(xyz) => (xyz, Decoder::C3dio, None),
-        Err(e) => (own.xyz.clone(), Decoder::Fallback, Some(e)),
+    let sample = decode::checked_frames(layout.frames);
+    let (decoder, c3dio_error) = match decode::via_c3dio(bytes, &layout, &header, &sample)
+        .and_then(|xyz| decode::agree(&xyz, &own, &layout, &sample))
+    {
+        Ok(()) => (Decoder::C3dio, None),
+        Err(e) => (Decoder::Fallback, Some(e)),
     };
-    let take = build_take(&layout, &xyz, &own.invalid);
+    let take = build_take(&layout, &own.xyz, &own.invalid);
     take.validate()?;
     let info = C3dInfo {
         processor,
@@ -143,10 +146,8 @@ pub fn read_with_info(bytes: &[u8]) -> Result<(Take, C3dInfo), ReadError> {
 }
 
 /// Reads a C3D take with emoshift's own decoder alone, as the frame-block reader
-/// ([`C3dBlocks`]) does, without c3dio's decoding, which costs about five times as much. [`read`]
-/// keeps c3dio's values where they agree with these to 1e-4 and these where they do not: on
-/// every c3d.org sample the two takes are the same, value for value. For the passes that read
-/// every take of a long session.
+/// ([`C3dBlocks`]) does: the take [`read`] gives, without its c3dio cross-check on a sample of
+/// frames. For the passes that read every take of a long session.
 ///
 /// # Errors
 /// As [`read`].
@@ -183,14 +184,19 @@ fn build_take(l: &layout::Layout, xyz: &[f32], invalid: &[bool]) -> Take {
 /// whole-file and frame-block readers so both give the same take.
 fn push_samples(l: &layout::Layout, xyz: &[f32], invalid: &[bool], take: &mut Take) {
     let to_mm = l.units.to_mm();
-    for (i, &bad) in invalid.iter().enumerate() {
-        let p = &xyz[i * 3..i * 3 + 3];
-        let gone = bad || p == [0.0; 3] || p.iter().any(|v| !v.is_finite());
-        if gone {
-            take.positions.extend([0.0; 3]);
-        } else {
-            take.positions.extend(p.iter().map(|v| v * to_mm));
+    let (p0, m0) = (take.positions.len(), take.missing.len());
+    take.positions.resize(p0 + invalid.len() * 3, 0.0);
+    take.missing.resize(m0 + invalid.len(), false);
+    let out = take.positions[p0..]
+        .chunks_exact_mut(3)
+        .zip(&mut take.missing[m0..]);
+    for ((o, gone), (p, &bad)) in out.zip(xyz.chunks_exact(3).zip(invalid)) {
+        let finite = p[0].is_finite() && p[1].is_finite() && p[2].is_finite();
+        *gone = bad || (p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0) || !finite;
+        if !*gone {
+            for (o, v) in o.iter_mut().zip(p) {
+                *o = v * to_mm;
+            }
         }
-        take.missing.push(gone);
     }
 }

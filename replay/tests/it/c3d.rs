@@ -59,6 +59,17 @@ fn assert_same(a: &Take, b: &Take, tol_mm: f32) {
     assert!(worst <= tol_mm, "positions differ by {worst} mm");
 }
 
+/// Past 256 frames c3dio reads a copy holding a sample of them (first and last included,
+/// padded to a whole block): it still confirms the decoding, and the take is every frame.
+#[test]
+fn a_long_take_is_cross_checked_on_a_sample_and_read_whole() {
+    let take = synthetic(9, 2_001, 5, 120.0);
+    let (back, info) = c3d::read_with_info(&write_bytes(&take)).expect("own output reads");
+    assert_eq!(info.decoder, Decoder::C3dio, "{info:?}");
+    assert_eq!(back.n_frames(), 2_001);
+    assert_same(&take, &back, 1e-3);
+}
+
 #[test]
 fn round_trip_keeps_labels_rate_first_frame_values_and_gaps() {
     let mut take = synthetic(12, 240, 17, 119.88);

@@ -113,27 +113,59 @@ fn every_sample_file_matches_the_verified_table_or_fails_cleanly() {
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
 
-/// Training decodes C3D points with emoshift's own decoder alone; on every sample file the
-/// cross-checked reader accepts, it gives the same take, value for value.
+/// The reader decodes every frame with emoshift's own decoder and asks c3dio about a sample of
+/// frames only; on every sample file c3dio reads whole on its own, the two agree on every frame
+/// (every sample the take holds, in file units), so the sample does not hide a disagreement. And
+/// the take without the cross-check (what training reads) is the same take.
 #[test]
-fn the_own_decoder_alone_reads_what_the_cross_checked_reader_reads() {
+fn c3dio_agrees_with_the_own_decoder_on_every_frame_of_every_sample() {
     let dir = samples_dir();
     let Some(files) = sample_files(&dir) else {
         return;
     };
     let limit = replay::file::DEFAULT_MAX_TAKE_BYTES;
-    let mut compared = 0;
+    let (mut compared, mut whole) = (0, 0);
     for path in &files {
-        let Ok(checked) = replay::load(path) else {
+        let Ok(take) = replay::load(path) else {
             continue;
         };
         let own = replay::load_with(path, limit, replay::C3dDecoding::Own)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         // Positions are finite (missing samples are stored as 0.0), so equality is exact.
-        assert!(own == checked, "{}: the takes differ", path.display());
+        assert!(own == take, "{}: the takes differ", path.display());
         compared += 1;
+        // c3dio alone reads files with their parameters at block 2 (not sample_08's).
+        let whole_file = std::panic::catch_unwind(|| c3dio::C3d::load_path(path.clone()).ok());
+        let Ok(Some(c)) = whole_file else {
+            continue;
+        };
+        let (n, frames) = (take.n_markers(), take.n_frames());
+        if c.points.cols() != n || c.points.rows() != frames {
+            continue;
+        }
+        let to_mm = take.source_units.to_mm();
+        for f in 0..frames {
+            for m in 0..n {
+                let Some(ours) = take.sample(f, m) else {
+                    continue;
+                };
+                for (a, b) in c.points[f][m].point.iter().zip(ours) {
+                    let a = a * to_mm;
+                    assert!(
+                        (a - b).abs() <= 1e-4 * b.abs().max(1.0),
+                        "{}: frame {f} marker {m}: c3dio {a} mm, ours {b} mm",
+                        path.display()
+                    );
+                }
+            }
+        }
+        whole += 1;
     }
     assert!(compared >= TABLE.len(), "compared {compared} files");
+    assert!(
+        whole * 2 >= compared,
+        "c3dio read only {whole} of {compared} whole"
+    );
 }
 
 /// Issue 36: no sample file is taken for a take cut off by a crash: the data of every file that
