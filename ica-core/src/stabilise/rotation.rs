@@ -44,7 +44,7 @@ fn collinear(h: &Matrix3<f64>) -> bool {
         - g[(0, 2)] * g[(2, 0)]
         + g[(1, 1)] * g[(2, 2)]
         - g[(1, 2)] * g[(2, 1)];
-    !(trace > 0.0) || e2 <= COLLINEAR * COLLINEAR * trace * trace
+    trace.is_nan() || trace <= 0.0 || e2 <= COLLINEAR * COLLINEAR * trace * trace
 }
 
 /// Horn's matrix `N(H)`, row by row.
@@ -137,7 +137,8 @@ fn quaternion_rotation(h: &Matrix3<f64>, norms: f64) -> Option<Matrix3<f64>> {
         .fold((0.0, &adj[0]), |acc, x| if x.0 > acc.0 { x } else { acc });
     let scale = lambda.abs().max(f64::MIN_POSITIVE);
     let floor = ADJUGATE_FLOOR * scale * scale * scale;
-    if !(norm2.sqrt() >= floor) {
+    // NaN (a degenerate input) falls back too.
+    if norm2.is_nan() || norm2.sqrt() < floor {
         return None;
     }
     let inv = 1.0 / norm2.sqrt();
