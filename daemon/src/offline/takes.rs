@@ -151,6 +151,28 @@ pub fn to_model_order(take: &Take, map: &LabelMap) -> ModelFrames {
 pub fn frames_in_model_order(take: &Take, map: &LabelMap, range: Range<usize>) -> ModelFrames {
     let markers = map.model_to_take.len();
     let frames = range.len();
+    let identity = markers == take.n_markers()
+        && map
+            .model_to_take
+            .iter()
+            .enumerate()
+            .all(|(i, t)| *t == Some(i));
+    if identity {
+        // The take has the model's markers in its order: one copy, then the missing
+        // samples zeroed (as gathering leaves them).
+        let mut xyz = take.positions[range.start * markers * 3..range.end * markers * 3].to_vec();
+        let missing = take.missing[range.start * markers..range.end * markers].to_vec();
+        for (p, &gone) in xyz.chunks_exact_mut(3).zip(&missing) {
+            if gone {
+                p.fill(0.0);
+            }
+        }
+        return ModelFrames {
+            xyz,
+            missing,
+            markers,
+        };
+    }
     let mut xyz = vec![0.0; frames * markers * 3];
     let mut missing = vec![true; frames * markers];
     for (k, f) in range.enumerate() {

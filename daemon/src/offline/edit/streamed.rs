@@ -67,21 +67,47 @@ pub fn edit_file(
     let output = Output::new(&header, model.labels(), &map);
     let pending = PendingOut::new(out);
     let at = (header.rate_hz, header.first_frame);
-    let writer = TakeWriter::create(pending.path(), &output.take.labels, at, source.frames())
+    let mut writer = TakeWriter::create(pending.path(), &output.take.labels, at, source.frames())
         .with_context(|| format!("{}", out.display()))?;
-    let mut sink = Edit {
-        editor: plan.editor(model)?,
-        resynth: FrameProcessor::new(model),
-        edited: vec![0.0; model.channels()],
-        keep_gaps: request.keep_gaps,
-        output,
-        writer,
-    };
-    let pass = (&mut source, &map);
-    let frames = run_pass(model, pass, block_frames, (progress, "editing"), &mut sink)?;
-    sink.writer
-        .finish()
-        .with_context(|| format!("{}", out.display()))?;
+    let spare = output.take.clone();
+    let frames = std::thread::scope(|s| -> Result<usize> {
+        // The blocks are encoded and written on a thread of their own while the next is edited;
+        // two blocks' buffers go round.
+        let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<replay::Take>(1);
+        let (free_tx, free_rx) = std::sync::mpsc::channel::<replay::Take>();
+        let written = s.spawn(move || -> Result<()> {
+            for block in full_rx {
+                writer.write_block(&block)?;
+                // The editor may have finished: a buffer it will not need.
+                let _ = free_tx.send(block);
+            }
+            writer.finish()?;
+            Ok(())
+        });
+        let mut sink = Edit {
+            editor: plan.editor(model)?,
+            resynth: FrameProcessor::new(model),
+            edited: vec![0.0; model.channels()],
+            keep_gaps: request.keep_gaps,
+            output,
+            spare: Some(spare),
+            full: full_tx,
+            free: free_rx,
+        };
+        let pass = (&mut source, &map);
+        let edited = run_pass(model, pass, block_frames, (progress, "editing"), &mut sink);
+        drop(sink);
+        let written = written
+            .join()
+            .map_err(|_| anyhow::anyhow!("the output writer panicked"))?
+            .with_context(|| format!("{}", out.display()));
+        match (edited, written) {
+            (Ok(frames), Ok(())) => Ok(frames),
+            // The writer failed first; the editor then found it gone.
+            (Err(e), Err(w)) if e.is::<WriterGone>() => Err(w),
+            (Err(e), _) | (Ok(_), Err(e)) => Err(e),
+        }
+    })?;
     pending.commit()?;
     Ok(EditSummary { frames, notices })
 }
@@ -96,7 +122,7 @@ impl FrameSink for Sums {
     }
 }
 
-/// The edit pass: edit, resynthesise, assemble, and write each block.
+/// The edit pass: edit, resynthesise, assemble each block, and hand it to the writer.
 struct Edit<'a> {
     editor: FrameEditor,
     /// Resynthesis has its own processor, as in the whole-take path.
@@ -104,7 +130,10 @@ struct Edit<'a> {
     edited: Vec<f32>,
     keep_gaps: bool,
     output: Output<'a>,
-    writer: TakeWriter,
+    /// An empty block of the output's markers before the writer returns one.
+    spare: Option<replay::Take>,
+    full: std::sync::mpsc::SyncSender<replay::Take>,
+    free: std::sync::mpsc::Receiver<replay::Take>,
 }
 
 impl FrameSink for Edit<'_> {
@@ -119,9 +148,18 @@ impl FrameSink for Edit<'_> {
     }
 
     fn end_block(&mut self) -> Result<()> {
-        self.writer.write_block(&self.output.take)?;
-        self.output.take.positions.clear();
-        self.output.take.missing.clear();
-        Ok(())
+        let mut next = match self.spare.take() {
+            Some(spare) => spare,
+            None => self.free.recv().map_err(|_| WriterGone)?,
+        };
+        next.positions.clear();
+        next.missing.clear();
+        let block = std::mem::replace(&mut self.output.take, next);
+        Ok(self.full.send(block).map_err(|_| WriterGone)?)
     }
 }
+
+/// The writer thread stopped: its own error says why.
+#[derive(Debug, thiserror::Error)]
+#[error("the output writer stopped")]
+struct WriterGone;

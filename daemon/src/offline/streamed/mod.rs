@@ -25,6 +25,7 @@ use ica_core::model::IcaModel;
 
 use crate::offline::progress::Progress;
 use crate::offline::takes::frames_in_model_order;
+use crate::offline::ModelFrames;
 use engine::frame::{FrameProcessor, Prepared};
 use engine::LabelMap;
 pub(crate) use output::PendingOut;
@@ -70,8 +71,15 @@ pub(crate) fn label_map(model: &IcaModel, source: &Source) -> Result<LabelMap> {
         .with_context(|| format!("{}", source.path().display()))
 }
 
+/// A block read and put in model order, or why reading stopped.
+type ReadBlock = Result<(replay::Take, ModelFrames)>;
+
 /// Projects every frame of `source` in blocks of `block_frames` and hands it to `sink`;
 /// reports progress as step `name`; returns the frames seen.
+///
+/// A reader thread decodes the next block (and puts it in model order) while this one
+/// processes the current: the frames are processed in order by one processor, as before, and
+/// the sink sees them in order. Two blocks' buffers go round between the two threads.
 ///
 /// # Errors
 /// The source's read errors (naming the file), or the sink's.
@@ -84,28 +92,54 @@ pub(crate) fn run_pass(
 ) -> Result<usize> {
     progress.step(name, "frames", source.frames().map(|n| n as u64));
     let mut processor = FrameProcessor::new(model);
-    let mut block = source.empty_take();
     let mut u = vec![0.0f32; model.components()];
     let mut index = 0;
-    while source.read_block(block_frames.max(1), &mut block)? > 0 {
-        let frames = frames_in_model_order(&block, map, 0..block.n_frames());
-        for k in 0..block.n_frames() {
-            let (xyz, missing) = frames.frame(k);
-            let prepared = processor.project(xyz, missing, &mut u)?;
-            sink.frame(Frame {
-                index: index + k,
-                source: (block.frame(k), block.frame_missing(k)),
-                model: (xyz, missing),
-                prepared,
-                u: &mut u,
-            })?;
+    let path = source.path().to_path_buf();
+    let empty = source.empty_take();
+    std::thread::scope(|s| -> Result<()> {
+        let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<ReadBlock>(1);
+        let (free_tx, free_rx) = std::sync::mpsc::channel::<replay::Take>();
+        for _ in 0..2 {
+            // Cannot fail: the receiver is alive.
+            let _ = free_tx.send(empty.clone());
         }
-        index += block.n_frames();
-        sink.end_block()?;
-        progress.advance(block.n_frames() as u64);
-    }
+        s.spawn(move || {
+            // Ends when the input ends, fails, or the processing side has gone.
+            while let Ok(mut block) = free_rx.recv() {
+                let read = match source.read_block(block_frames.max(1), &mut block) {
+                    Ok(0) => return,
+                    Ok(_) => Ok(frames_in_model_order(&block, map, 0..block.n_frames())),
+                    Err(e) => Err(e),
+                };
+                let failed = read.is_err();
+                if full_tx.send(read.map(|frames| (block, frames))).is_err() || failed {
+                    return;
+                }
+            }
+        });
+        for read in full_rx {
+            let (block, frames) = read?;
+            for k in 0..block.n_frames() {
+                let (xyz, missing) = frames.frame(k);
+                let prepared = processor.project(xyz, missing, &mut u)?;
+                sink.frame(Frame {
+                    index: index + k,
+                    source: (block.frame(k), block.frame_missing(k)),
+                    model: (xyz, missing),
+                    prepared,
+                    u: &mut u,
+                })?;
+            }
+            index += block.n_frames();
+            sink.end_block()?;
+            progress.advance(block.n_frames() as u64);
+            // The reader may have finished: a buffer it will not need.
+            let _ = free_tx.send(block);
+        }
+        Ok(())
+    })?;
     if index == 0 {
-        anyhow::bail!("{}: take has no frames", source.path().display());
+        anyhow::bail!("{}: take has no frames", path.display());
     }
     Ok(index)
 }
