@@ -203,8 +203,13 @@ impl Take {
             }
         }
         // When every value (missing ones included) is finite and plausible, so is every present
-        // sample: one pass the compiler vectorises; the loop below names the first bad one.
-        if self.positions.iter().all(|v| v.abs() <= MAX_COORDINATE_MM) {
+        // sample: one pass the compiler vectorises (no early exit inside a chunk; NaN fails the
+        // comparison); the loop below names the first bad one.
+        let plausible = |c: &[f32]| {
+            c.iter()
+                .fold(true, |ok, v| ok & (v.abs() <= MAX_COORDINATE_MM))
+        };
+        if self.positions.chunks(4096).all(plausible) {
             return Ok(());
         }
         for (i, &gone) in self.missing.iter().enumerate() {

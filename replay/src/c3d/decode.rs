@@ -29,19 +29,25 @@ pub struct Samples {
     pub invalid: Vec<bool>,
 }
 
-/// Decodes every sample with our own decoder. The layout has already checked the length.
-pub fn own(bytes: &[u8], l: &Layout) -> Samples {
-    let n = l.frames * l.points;
+/// Decodes the frames at `frames` (0-based indices) with our own decoder, in that order. The
+/// layout has already checked the length.
+pub fn own(bytes: &[u8], l: &Layout, frames: impl ExactSizeIterator<Item = usize>) -> Samples {
+    let n = frames.len() * l.points;
     let mut s = Samples {
         xyz: Vec::with_capacity(n * 3),
         invalid: Vec::with_capacity(n),
     };
-    for f in 0..l.frames {
-        let start = l.data_offset + f * l.frame_bytes();
-        let frame = bytes.get(start..).unwrap_or(&[]);
-        frame_into(frame, l, &mut s.xyz, &mut s.invalid);
+    for f in frames {
+        frame_into(record(bytes, l, f), l, &mut s.xyz, &mut s.invalid);
     }
     s
+}
+
+/// Frame `f`'s record and whatever follows it (empty past the end).
+pub fn record<'a>(bytes: &'a [u8], l: &Layout, f: usize) -> &'a [u8] {
+    bytes
+        .get(l.data_offset + f * l.frame_bytes()..)
+        .unwrap_or(&[])
 }
 
 /// Decodes one frame record (points then analog samples; only the points are read) and appends
@@ -169,27 +175,26 @@ pub fn via_c3dio(
     Ok(xyz)
 }
 
-/// Checks c3dio's values of the frames `sample` against our own decoding of the same bytes,
-/// over valid samples: a difference beyond float rounding means one of the two misread the
-/// layout, and ours is the one whose every step is checked against the header.
+/// Checks c3dio's values of the frames `sample` against our own decoding of the same frames
+/// (`own`, in the same order), over valid samples: a difference beyond float rounding means one
+/// of the two misread the layout, and ours is the one whose every step is checked against the
+/// header.
 pub fn agree(c3dio: &[f32], own: &Samples, l: &Layout, sample: &[usize]) -> Result<(), String> {
-    let n = l.points;
-    for (k, &f) in sample.iter().enumerate() {
-        for m in 0..n {
-            let (i, j) = (f * n + m, k * n + m);
-            if own.invalid[i] {
-                continue;
-            }
-            let pairs = c3dio[j * 3..j * 3 + 3]
-                .iter()
-                .zip(&own.xyz[i * 3..i * 3 + 3]);
-            for (&a, &b) in pairs {
-                let both_nan = a.is_nan() && b.is_nan();
-                if !both_nan && (a - b).abs() > 1e-4 * b.abs().max(1.0) {
-                    return Err(format!(
-                        "c3dio reads {a} where the raw data holds {b} (frame index {f}, point {m})"
-                    ));
-                }
+    for (i, &bad) in own.invalid.iter().enumerate() {
+        if bad {
+            continue;
+        }
+        let pairs = c3dio[i * 3..i * 3 + 3]
+            .iter()
+            .zip(&own.xyz[i * 3..i * 3 + 3]);
+        for (&a, &b) in pairs {
+            let both_nan = a.is_nan() && b.is_nan();
+            if !both_nan && (a - b).abs() > 1e-4 * b.abs().max(1.0) {
+                return Err(format!(
+                    "c3dio reads {a} where the raw data holds {b} (frame index {}, point {})",
+                    sample[i / l.points],
+                    i % l.points
+                ));
             }
         }
     }

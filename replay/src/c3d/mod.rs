@@ -125,15 +125,15 @@ pub fn analog_per_frame(head: &[u8]) -> Result<usize, C3dError> {
 /// As [`read`].
 pub fn read_with_info(bytes: &[u8]) -> Result<(Take, C3dInfo), ReadError> {
     let (processor, header, layout) = parse_layout(bytes)?;
-    let own = decode::own(bytes, &layout);
     let sample = decode::checked_frames(layout.frames);
+    let own = decode::own(bytes, &layout, sample.iter().copied());
     let (decoder, c3dio_error) = match decode::via_c3dio(bytes, &layout, &header, &sample)
         .and_then(|xyz| decode::agree(&xyz, &own, &layout, &sample))
     {
         Ok(()) => (Decoder::C3dio, None),
         Err(e) => (Decoder::Fallback, Some(e)),
     };
-    let take = build_take(&layout, &own.xyz, &own.invalid);
+    let take = decode_take(bytes, &layout);
     take.validate()?;
     let info = C3dInfo {
         processor,
@@ -155,8 +155,7 @@ pub fn read_own(mut input: impl Read) -> Result<Take, ReadError> {
     let mut bytes = Vec::new();
     input.read_to_end(&mut bytes)?;
     let (_, _, layout) = parse_layout(&bytes)?;
-    let own = decode::own(&bytes, &layout);
-    let take = build_take(&layout, &own.xyz, &own.invalid);
+    let take = decode_take(&bytes, &layout);
     take.validate()?;
     Ok(take)
 }
@@ -169,13 +168,26 @@ fn parse_layout(bytes: &[u8]) -> Result<(Processor, binary::Header, layout::Layo
     Ok((processor, header, layout))
 }
 
-/// Converts to millimetres and applies the missing rule ([`push_samples`]).
-fn build_take(l: &layout::Layout, xyz: &[f32], invalid: &[bool]) -> Take {
+/// Decodes every frame into a take: millimetres, the missing rule applied ([`push_samples`]).
+/// Frames go through a small buffer that stays in cache, so the file's bytes are read once and
+/// the take written once.
+fn decode_take(bytes: &[u8], l: &layout::Layout) -> Take {
+    /// Frames decoded per trip through the buffer.
+    const CHUNK: usize = 64;
     let mut take = Take::new(l.labels.clone(), l.rate_hz, l.first_frame);
     take.source_units = l.units;
-    take.positions.reserve(xyz.len());
-    take.missing.reserve(invalid.len());
-    push_samples(l, xyz, invalid, &mut take);
+    take.positions.reserve_exact(l.frames * l.points * 3);
+    take.missing.reserve_exact(l.frames * l.points);
+    let mut xyz = Vec::with_capacity(CHUNK * l.points * 3);
+    let mut invalid = Vec::with_capacity(CHUNK * l.points);
+    for start in (0..l.frames).step_by(CHUNK) {
+        xyz.clear();
+        invalid.clear();
+        for f in start..(start + CHUNK).min(l.frames) {
+            decode::frame_into(decode::record(bytes, l, f), l, &mut xyz, &mut invalid);
+        }
+        push_samples(l, &xyz, &invalid, &mut take);
+    }
     take
 }
 
@@ -190,13 +202,14 @@ fn push_samples(l: &layout::Layout, xyz: &[f32], invalid: &[bool], take: &mut Ta
     let out = take.positions[p0..]
         .chunks_exact_mut(3)
         .zip(&mut take.missing[m0..]);
+    // Branch-free: the compiler selects instead of jumping per sample.
     for ((o, gone), (p, &bad)) in out.zip(xyz.chunks_exact(3).zip(invalid)) {
-        let finite = p[0].is_finite() && p[1].is_finite() && p[2].is_finite();
-        *gone = bad || (p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0) || !finite;
-        if !*gone {
-            for (o, v) in o.iter_mut().zip(p) {
-                *o = v * to_mm;
-            }
+        let finite = p[0].is_finite() & p[1].is_finite() & p[2].is_finite();
+        let zero = (p[0] == 0.0) & (p[1] == 0.0) & (p[2] == 0.0);
+        let g = bad | zero | !finite;
+        *gone = g;
+        for (o, v) in o.iter_mut().zip(p) {
+            *o = if g { 0.0 } else { v * to_mm };
         }
     }
 }
