@@ -10,7 +10,8 @@ use replay::TakeWriter;
 use super::{plan, ComponentSums, EditRequest, FrameEditor, Output};
 use crate::offline::progress::Progress;
 use crate::offline::streamed::{
-    label_map, run_pass, source_notices, Frame, FrameSink, PendingOut, Source,
+    label_map, run_pass, source_notices, with_writer, BlockWrite, Frame, FrameSink, Handoff,
+    PendingOut, Source,
 };
 use engine::frame::FrameProcessor;
 
@@ -67,46 +68,21 @@ pub fn edit_file(
     let output = Output::new(&header, model.labels(), &map);
     let pending = PendingOut::new(out);
     let at = (header.rate_hz, header.first_frame);
-    let mut writer = TakeWriter::create(pending.path(), &output.take.labels, at, source.frames())
+    let writer = TakeWriter::create(pending.path(), &output.take.labels, at, source.frames())
         .with_context(|| format!("{}", out.display()))?;
     let spare = output.take.clone();
-    let frames = std::thread::scope(|s| -> Result<usize> {
-        // The blocks are encoded and written on a thread of their own while the next is edited;
-        // two blocks' buffers go round.
-        let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<replay::Take>(1);
-        let (free_tx, free_rx) = std::sync::mpsc::channel::<replay::Take>();
-        let written = s.spawn(move || -> Result<()> {
-            for block in full_rx {
-                writer.write_block(&block)?;
-                // The editor may have finished: a buffer it will not need.
-                let _ = free_tx.send(block);
-            }
-            writer.finish()?;
-            Ok(())
-        });
+    // The blocks are encoded and written on a thread of their own while the next is edited.
+    let frames = with_writer(spare, TakeOut(writer, out), |handoff| {
         let mut sink = Edit {
             editor: plan.editor(model)?,
             resynth: FrameProcessor::new(model),
             edited: vec![0.0; model.channels()],
             keep_gaps: request.keep_gaps,
             output,
-            spare: Some(spare),
-            full: full_tx,
-            free: free_rx,
+            handoff,
         };
         let pass = (&mut source, &map);
-        let edited = run_pass(model, pass, block_frames, (progress, "editing"), &mut sink);
-        drop(sink);
-        let written = written
-            .join()
-            .map_err(|_| anyhow::anyhow!("the output writer panicked"))?
-            .with_context(|| format!("{}", out.display()));
-        match (edited, written) {
-            (Ok(frames), Ok(())) => Ok(frames),
-            // The writer failed first; the editor then found it gone.
-            (Err(e), Err(w)) if e.is::<WriterGone>() => Err(w),
-            (Err(e), _) | (Ok(_), Err(e)) => Err(e),
-        }
+        run_pass(model, pass, block_frames, (progress, "editing"), &mut sink)
     })?;
     pending.commit()?;
     Ok(EditSummary { frames, notices })
@@ -130,10 +106,7 @@ struct Edit<'a> {
     edited: Vec<f32>,
     keep_gaps: bool,
     output: Output<'a>,
-    /// An empty block of the output's markers before the writer returns one.
-    spare: Option<replay::Take>,
-    full: std::sync::mpsc::SyncSender<replay::Take>,
-    free: std::sync::mpsc::Receiver<replay::Take>,
+    handoff: Handoff<replay::Take>,
 }
 
 impl FrameSink for Edit<'_> {
@@ -148,18 +121,28 @@ impl FrameSink for Edit<'_> {
     }
 
     fn end_block(&mut self) -> Result<()> {
-        let mut next = match self.spare.take() {
-            Some(spare) => spare,
-            None => self.free.recv().map_err(|_| WriterGone)?,
-        };
-        next.positions.clear();
-        next.missing.clear();
-        let block = std::mem::replace(&mut self.output.take, next);
-        Ok(self.full.send(block).map_err(|_| WriterGone)?)
+        self.handoff.send(&mut self.output.take, |next| {
+            next.positions.clear();
+            next.missing.clear();
+        })
     }
 }
 
-/// The writer thread stopped: its own error says why.
-#[derive(Debug, thiserror::Error)]
-#[error("the output writer stopped")]
-struct WriterGone;
+/// The edited take's file, written on the writer thread.
+struct TakeOut<'a>(TakeWriter, &'a Path);
+
+impl BlockWrite<replay::Take> for TakeOut<'_> {
+    fn write(&mut self, block: &replay::Take) -> Result<()> {
+        let out = self.1;
+        self.0
+            .write_block(block)
+            .with_context(|| format!("{}", out.display()))
+    }
+
+    fn finish(self) -> Result<()> {
+        let out = self.1;
+        self.0
+            .finish()
+            .with_context(|| format!("{}", out.display()))
+    }
+}

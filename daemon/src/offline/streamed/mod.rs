@@ -14,6 +14,7 @@
 //! Outputs are written to a hidden file beside the output and renamed over it when complete:
 //! a failure half way (a truncated input) leaves no partial file.
 
+mod handoff;
 mod output;
 mod project;
 mod source;
@@ -28,6 +29,7 @@ use crate::offline::takes::frames_in_model_order;
 use crate::offline::ModelFrames;
 use engine::frame::{FrameProcessor, Prepared};
 use engine::LabelMap;
+pub(crate) use handoff::{with_writer, BlockWrite, Handoff};
 pub(crate) use output::PendingOut;
 pub(crate) use source::Source;
 

@@ -7,7 +7,10 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use ica_core::model::IcaModel;
 
-use super::{label_map, run_pass, source_notices, Frame, FrameSink, PendingOut, Source};
+use super::{
+    label_map, run_pass, source_notices, with_writer, BlockWrite, Frame, FrameSink, Handoff,
+    PendingOut, Source,
+};
 use crate::offline::progress::Progress;
 
 /// What [`project_file`] did.
@@ -49,8 +52,10 @@ pub fn project_file(
     let m = model.components();
     let mut csv = Csv {
         out: BufWriter::new(file),
+        path: out,
         first_frame: header.first_frame,
         rate_hz: header.rate_hz,
+        components: m,
         line: String::new(),
     };
     write!(csv.out, "frame,time")?;
@@ -58,48 +63,19 @@ pub fn project_file(
         write!(csv.out, ",c{k}")?;
     }
     writeln!(csv.out)?;
-    let (frames, masked, held) = std::thread::scope(|s| -> Result<(usize, usize, usize)> {
-        // The rows are formatted and written on a thread of their own while the next block
-        // is projected; two blocks' buffers go round.
-        let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<Block>(1);
-        let (free_tx, free_rx) = std::sync::mpsc::channel::<Block>();
-        let written = s.spawn(move || -> Result<()> {
-            for block in full_rx {
-                csv.write(&block, m)?;
-                let _ = free_tx.send(block);
-            }
-            csv.out.flush()?;
-            Ok(())
-        });
+    // The rows are formatted and written on a thread of their own while the next block is
+    // projected.
+    let (frames, masked, held) = with_writer(Block::default(), csv, |handoff| {
         let mut rows = Rows {
             block: Block::default(),
-            spare: Some(Block::default()),
-            full: full_tx,
-            free: free_rx,
+            handoff,
             masked: 0,
             held: 0,
         };
         let pass = (&mut source, &map);
-        let projected = run_pass(
-            model,
-            pass,
-            block_frames,
-            (progress, "projecting"),
-            &mut rows,
-        );
-        let (masked, held) = (rows.masked, rows.held);
-        // Closes the channel: the writer flushes and ends.
-        drop(rows);
-        let written = written
-            .join()
-            .map_err(|_| anyhow::anyhow!("the output writer panicked"))?
-            .with_context(|| format!("cannot write {}", out.display()));
-        match (projected, written) {
-            (Ok(frames), Ok(())) => Ok((frames, masked, held)),
-            // The writer failed first; the projection then found it gone.
-            (Err(e), Err(w)) if e.is::<WriterGone>() => Err(w),
-            (Err(e), _) | (Ok(_), Err(e)) => Err(e),
-        }
+        let stage = (progress, "projecting");
+        let frames = run_pass(model, pass, block_frames, stage, &mut rows)?;
+        Ok((frames, rows.masked, rows.held))
     })?;
     pending.commit()?;
     Ok(ProjectSummary {
@@ -118,19 +94,21 @@ struct Block {
     u: Vec<f32>,
 }
 
-/// The CSV output: `frame,time,c0,...` per frame.
-struct Csv {
+/// The CSV output: `frame,time,c0,...` per frame, written on the writer thread.
+struct Csv<'a> {
     out: BufWriter<File>,
+    path: &'a Path,
     first_frame: i64,
     rate_hz: f64,
+    components: usize,
     /// One row, reused.
     line: String,
 }
 
-impl Csv {
-    fn write(&mut self, block: &Block, m: usize) -> Result<()> {
+impl Csv<'_> {
+    fn rows(&mut self, block: &Block) -> Result<()> {
         use std::fmt::Write as _;
-        for (k, u) in block.u.chunks_exact(m.max(1)).enumerate() {
+        for (k, u) in block.u.chunks_exact(self.components.max(1)).enumerate() {
             let f = block.first + k;
             let time = f as f64 / self.rate_hz;
             self.line.clear();
@@ -145,19 +123,26 @@ impl Csv {
     }
 }
 
-/// The writer thread stopped: its own error says why.
-#[derive(Debug, thiserror::Error)]
-#[error("the output writer stopped")]
-struct WriterGone;
+impl BlockWrite<Block> for Csv<'_> {
+    fn write(&mut self, block: &Block) -> Result<()> {
+        let path = self.path;
+        self.rows(block)
+            .with_context(|| format!("cannot write {}", path.display()))
+    }
+
+    fn finish(mut self) -> Result<()> {
+        let path = self.path;
+        self.out
+            .flush()
+            .with_context(|| format!("cannot write {}", path.display()))
+    }
+}
 
 /// The projection pass: each frame's components into the block, each block to the writer,
 /// and the counts the summary reports.
 struct Rows {
     block: Block,
-    /// An empty block before the writer returns one.
-    spare: Option<Block>,
-    full: std::sync::mpsc::SyncSender<Block>,
-    free: std::sync::mpsc::Receiver<Block>,
+    handoff: Handoff<Block>,
     masked: usize,
     held: usize,
 }
@@ -174,12 +159,6 @@ impl FrameSink for Rows {
     }
 
     fn end_block(&mut self) -> Result<()> {
-        let mut next = match self.spare.take() {
-            Some(spare) => spare,
-            None => self.free.recv().map_err(|_| WriterGone)?,
-        };
-        next.u.clear();
-        let block = std::mem::replace(&mut self.block, next);
-        Ok(self.full.send(block).map_err(|_| WriterGone)?)
+        self.handoff.send(&mut self.block, |next| next.u.clear())
     }
 }
