@@ -232,6 +232,11 @@ fn shortlist(
         })
         .collect();
     assessed.extend(cores.into_par_iter().filter_map(coarse).collect::<Vec<_>>());
+    pick_shortlist(&assessed)
+}
+
+/// Out of the coarse assessments, the groups [`shortlist`] passes on.
+fn pick_shortlist(assessed: &[GroupAssessment]) -> Vec<Vec<usize>> {
     let least = assessed
         .iter()
         .map(|c| c.leakage)
