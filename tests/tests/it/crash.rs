@@ -92,14 +92,7 @@ async fn issue_36_serve_recording_killed_after_3_s_keeps_all_but_the_last_second
             raw: Some(raw_out.display().to_string()),
             overwrite: false,
         };
-        let mut reply = None;
-        for _ in 0..50 {
-            let attempt = tokio::time::timeout(Duration::from_millis(200), control.send(&start));
-            if let Ok(r) = attempt.await {
-                reply = Some(r);
-                break;
-            }
-        }
+        let reply = control.send_when_up(&start).await;
         assert!(matches!(reply, Some(Reply::Confirm(_))), "{reply:?}");
         stream_at_120_hz(
             &m.model,

@@ -30,14 +30,7 @@ async fn a_recording_is_complete_after_sigterm() {
         overwrite: false,
     };
     // The child needs a moment to bind: retry the first control until it answers.
-    let mut reply = None;
-    for _ in 0..50 {
-        let attempt = tokio::time::timeout(Duration::from_millis(200), control.send(&start));
-        if let Ok(r) = attempt.await {
-            reply = Some(r);
-            break;
-        }
-    }
+    let reply = control.send_when_up(&start).await;
     assert!(matches!(reply, Some(Reply::Confirm(_))), "{reply:?}");
     let sent = stage_frames(&m.model, 90);
     let source = Source::new(format!("127.0.0.1:{fp}").parse().expect("addr"), &m.model).await;
@@ -158,15 +151,7 @@ async fn model_load_of_a_device_or_a_fifo_is_answered_at_once_and_sigterm_still_
         .spawn()
         .expect("the binary starts");
     let control = ControlClient::new(format!("127.0.0.1:{cp}").parse().expect("addr")).await;
-    let mut up = false;
-    for _ in 0..50 {
-        let attempt =
-            tokio::time::timeout(Duration::from_millis(200), control.send(&Control::Status));
-        if attempt.await.is_ok() {
-            up = true;
-            break;
-        }
-    }
+    let up = control.send_when_up(&Control::Status).await.is_some();
     assert!(up, "the daemon answers /status");
     for path in ["/dev/zero".into(), fifo.display().to_string()] {
         let t = Instant::now();

@@ -140,6 +140,18 @@ impl ControlClient {
             .expect("a well-formed reply within 5 s")
     }
 
+    /// `c`, retried every 200 ms for up to 10 s while a daemon just spawned binds its control
+    /// socket: its reply, or `None` when it never answered.
+    pub async fn send_when_up(&self, c: &Control) -> Option<Reply> {
+        for _ in 0..50 {
+            let attempt = tokio::time::timeout(Duration::from_millis(200), self.send(c));
+            if let Ok(reply) = attempt.await {
+                return Some(reply);
+            }
+        }
+        None
+    }
+
     pub async fn status(&self, name: &str) -> i64 {
         let pairs = self.0.status().await.expect("a status");
         loopback::counter(&pairs, name).unwrap_or_else(|| panic!("no counter {name}"))

@@ -121,14 +121,7 @@ impl Session {
 
     /// Records a frame sent to client `i` (`bytes` long, or failed).
     pub fn handle_send(&mut self, i: usize, sent: Option<usize>, now: Instant) {
-        match sent {
-            Some(0) => self.counters.dropped_send_buffer += 1,
-            Some(n) => {
-                self.counters.frames_sent += 1;
-                self.counters.bytes_sent += n as u64;
-            }
-            None => self.counters.send_errors += 1,
-        }
+        self.count_sent(sent);
         if self.clients.handle_send(i, sent.is_some(), now) == SendOutcome::Dropped {
             tracing::info!(target: "emoshift", "natnet_server: a client dropped after repeated send failures");
         }
@@ -136,6 +129,11 @@ impl Session {
 
     /// Records a frame sent to the group.
     pub fn handle_multicast(&mut self, sent: Option<usize>) {
+        self.count_sent(sent);
+    }
+
+    /// A frame's send in the counters: `Some(0)` a full send buffer, `None` a send error.
+    fn count_sent(&mut self, sent: Option<usize>) {
         match sent {
             Some(0) => self.counters.dropped_send_buffer += 1,
             Some(n) => {
