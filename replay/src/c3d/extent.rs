@@ -130,7 +130,13 @@ pub(crate) fn patch(file: &mut File, e: &Extent, frames: usize) -> Result<(), Pa
     if frames == 0 {
         return Err(PatchError::NoFrames);
     }
-    let first = e.first_frame;
+    // As stored: a take whose first frame is past 65535 is numbered from 1 in the header and
+    // TRIAL (its true first frame in EMOSHIFT:FIRST_FRAME, which does not change).
+    let first = if e.first_frame > i64::from(u16::MAX) {
+        1
+    } else {
+        e.first_frame
+    };
     let last = first + frames as i64 - 1;
     let long = frames > usize::from(u16::MAX) || last > i64::from(u16::MAX);
     let [point_frames, long_frames, end_field] = &e.fields;

@@ -137,15 +137,20 @@ fn rate(h: &Header, params: &Params) -> Result<f64, C3dError> {
 /// First frame and frame count, and a POINT:FRAMES (or LONG_FRAMES) disagreement. The header's
 /// range wins: the caller checks the data holds it (some writers store POINT:FRAMES one too
 /// high). The header's 16-bit last frame saturates at 65535; writers then store the real range
-/// in TRIAL:ACTUAL_START_FIELD / ACTUAL_END_FIELD as (low, high) words.
+/// in TRIAL:ACTUAL_START_FIELD / ACTUAL_END_FIELD as (low, high) words. A first frame past
+/// 65535 cannot be in the header at all: emoshift then stores the take numbered from 1 and its
+/// true first frame in EMOSHIFT:FIRST_FRAME, applied here.
 fn frame_range(h: &Header, params: &Params) -> Result<(i64, usize, Option<C3dError>), C3dError> {
-    let field = |name: &str| -> Option<i64> {
-        let v = params.numbers("TRIAL", name, true)?;
+    let field = |group: &str, name: &str| -> Option<i64> {
+        let v = params.numbers(group, name, true)?;
         (v.len() == 2).then(|| v[0] as i64 + ((v[1] as i64) << 16))
     };
     let (mut first, mut last) = (i64::from(h.first_frame), i64::from(h.last_frame));
     if h.last_frame == u16::MAX {
-        if let (Some(s), Some(e)) = (field("ACTUAL_START_FIELD"), field("ACTUAL_END_FIELD")) {
+        if let (Some(s), Some(e)) = (
+            field("TRIAL", "ACTUAL_START_FIELD"),
+            field("TRIAL", "ACTUAL_END_FIELD"),
+        ) {
             (first, last) = (s, e);
         }
     }
@@ -167,6 +172,7 @@ fn frame_range(h: &Header, params: &Params) -> Result<(i64, usize, Option<C3dErr
         }),
         _ => None,
     };
+    let first = field("EMOSHIFT", "FIRST_FRAME").unwrap_or(first);
     Ok((first, header, warning))
 }
 

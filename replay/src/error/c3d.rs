@@ -117,8 +117,8 @@ pub enum C3dLimitError {
         /// Its length in bytes.
         len: usize,
     },
-    /// The first frame number does not fit the header's unsigned 16-bit word.
-    #[error("c3d first frame must be in 0..=65535, take starts at {0}")]
+    /// A negative first frame number (C3D numbers frames from 0 up).
+    #[error("c3d frame numbers cannot be negative, take starts at {0}: write TRC or CSV, or renumber the take")]
     FirstFrameOutOfRange(i64),
     /// More frames than the TRIAL:ACTUAL_END_FIELD pair of words can count.
     #[error("c3d frame range {first}..{last} does not fit in 32 bits")]

@@ -109,8 +109,8 @@ impl Recorder {
     /// # Errors
     /// [`WriteError::UnknownFormat`] for another extension; [`WriteError::Invalid`] for no labels,
     /// an empty or repeated label or a rate that is not positive and finite; what the format
-    /// cannot hold (a separator in a TRC/CSV label, C3D limits such as a first frame outside
-    /// 0..=65535); or an I/O error creating the file.
+    /// cannot hold (a separator in a TRC/CSV label, C3D limits such as a negative first frame);
+    /// or an I/O error creating the file.
     pub fn create(
         path: &Path,
         labels: Vec<String>,

@@ -122,8 +122,32 @@ fn takes_c3d_cannot_hold_are_refused_with_the_reason() {
     let err = c3d::write(&negative, &mut Vec::new()).expect_err("negative first frame");
     assert_eq!(
         err.to_string(),
-        "c3d first frame must be in 0..=65535, take starts at -3"
+        "c3d frame numbers cannot be negative, take starts at -3: write TRC or CSV, or renumber \
+         the take"
     );
+}
+
+/// A live source's frame numbers pass 65535 after nine minutes at 120 Hz (Motive's run from its
+/// start): such a take is stored numbered from 1, so every reader counts its frames, with its
+/// true first frame in EMOSHIFT:FIRST_FRAME, which emoshift reads back.
+#[test]
+fn a_first_frame_past_65535_keeps_its_numbers_and_the_header_counts_from_1() {
+    for (first, frames) in [(150_000, 40), (65_530, 12), (70_000, 70_000)] {
+        let take = synthetic(3, frames, first, 120.0);
+        let bytes = write_bytes(&take);
+        let word = |at: usize| u16::from_le_bytes([bytes[at], bytes[at + 1]]);
+        let header_first = if first > 65_535 { 1 } else { first as u16 };
+        assert_eq!(word(6), header_first, "header first frame of {first}");
+        let header_last = (i64::from(header_first) + frames as i64 - 1).min(65_535);
+        assert_eq!(
+            i64::from(word(8)),
+            header_last,
+            "header last frame of {first}"
+        );
+        let back = c3d::read(&bytes[..]).expect("reads");
+        assert_eq!(back.first_frame, first);
+        assert_same(&take, &back, 1e-3);
+    }
 }
 
 #[test]

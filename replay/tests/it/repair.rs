@@ -210,6 +210,25 @@ fn issue_36_a_take_cut_anywhere_reads_as_its_header_and_repairs_to_every_whole_f
     }
 }
 
+/// A take recorded from a live source whose frame numbers passed 65535 (its header numbered
+/// from 1, TRIAL holding the true range) repairs with its numbers kept.
+#[test]
+fn a_c3d_numbered_past_65535_repairs_with_its_numbers() {
+    let mut take = generated(12);
+    take.first_frame = 200_000;
+    let dir = tempfile::tempdir().expect("dir");
+    let path = dir.path().join("late.c3d");
+    std::fs::write(&path, cut_off(Format::C3d, &take, 8, 11, 0)).unwrap();
+    assert_same_frames(
+        &replay::load(&path).unwrap(),
+        &first(&take, 8),
+        "before repair",
+    );
+    assert_eq!(repair::inspect(&path).unwrap().data_frames, 11);
+    assert_eq!(repair::repair(&path, None).unwrap().frames, 11);
+    assert_same_frames(&replay::load(&path).unwrap(), &first(&take, 11), "repaired");
+}
+
 #[test]
 fn a_trc_last_row_without_its_newline_is_kept_when_the_header_counts_it() {
     // A file of another program that lacks its final newline is not damaged.

@@ -36,8 +36,8 @@ const MAX_PARAMETER_BLOCKS: usize = 255;
 ///
 /// # Errors
 /// [`WriteError::Invalid`] for a take that breaks its invariants, [`WriteError::C3dLimit`] for
-/// one C3D cannot hold (no frames, too many markers, a label over 255 bytes, a first frame
-/// outside 0..=65535), or an I/O error.
+/// one C3D cannot hold (no frames, too many markers, a label over 255 bytes, a negative first
+/// frame), or an I/O error.
 pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
     take.validate()?;
     let frames = take.n_frames();
@@ -50,8 +50,8 @@ pub fn write(take: &Take, out: &mut impl Write) -> Result<(), WriteError> {
 /// frame.
 ///
 /// # Errors
-/// What C3D cannot hold (no frames, too many markers, a long label, a first frame outside
-/// 0..=65535), or an I/O error.
+/// What C3D cannot hold (no frames, too many markers, a long label, a negative first frame),
+/// or an I/O error.
 pub(crate) fn write_head(
     out: &mut impl Write,
     labels: &[String],
@@ -184,32 +184,55 @@ pub(crate) fn encode_frame(xyz: &[f32], missing: &[bool], buf: &mut Vec<u8>) {
 }
 
 /// The frame numbers as the header and TRIAL store them.
+///
+/// The header's first frame is a 16-bit word. A take whose first frame is past 65535 (a live
+/// source's numbers, e.g. Motive's after nine minutes at 120 Hz) is stored numbered from 1,
+/// in the header and TRIAL alike, so every reader counts its frames right; its true first frame
+/// goes in EMOSHIFT:FIRST_FRAME, which emoshift's reader applies.
 pub(crate) struct FrameRange {
+    /// The first and last frame as stored (numbered from 1 when renumbered).
     first: u32,
     last: u32,
     count: usize,
+    /// The true first frame of a renumbered take.
+    renumbered_from: Option<u32>,
 }
 
 impl FrameRange {
     /// The range of `frames` frames numbered from `first_frame`.
     ///
     /// # Errors
-    /// No frames, a first frame outside 0..=65535, a last frame past 32 bits.
+    /// No frames, a negative first frame, a last frame past 32 bits.
     pub(crate) fn new(first_frame: i64, frames: usize) -> Result<FrameRange, C3dLimitError> {
         if frames == 0 {
             return Err(C3dLimitError::NoFrames);
         }
-        let first = u16::try_from(first_frame)
+        let true_first = u32::try_from(first_frame)
             .map_err(|_| C3dLimitError::FirstFrameOutOfRange(first_frame))?;
         let last = first_frame + frames as i64 - 1;
-        let last = u32::try_from(last).map_err(|_| C3dLimitError::TooManyFrames {
-            first: first_frame,
-            last,
+        if u32::try_from(last).is_err() {
+            return Err(C3dLimitError::TooManyFrames {
+                first: first_frame,
+                last,
+            });
+        }
+        let renumbered_from = (true_first > u32::from(u16::MAX)).then_some(true_first);
+        let first = if renumbered_from.is_some() {
+            1
+        } else {
+            true_first
+        };
+        let last = u32::try_from(i64::from(first) + frames as i64 - 1).map_err(|_| {
+            C3dLimitError::TooManyFrames {
+                first: first_frame,
+                last,
+            }
         })?;
         Ok(FrameRange {
-            first: u32::from(first),
+            first,
             last,
             count: frames,
+            renumbered_from,
         })
     }
 

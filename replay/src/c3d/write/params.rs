@@ -10,6 +10,7 @@ const POINT: i8 = 1;
 const ANALOG: i8 = 2;
 const FORCE_PLATFORM: i8 = 3;
 const TRIAL: i8 = 4;
+const EMOSHIFT: i8 = 5;
 
 pub(super) fn parameters(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -> Vec<u8> {
     let mut w = Records::default();
@@ -56,6 +57,10 @@ pub(super) fn parameters(meta: &Meta<'_>, range: &FrameRange, data_block: u16) -
     }
     if let Some(tc) = meta.time.and_then(|t| t.timecode) {
         timecode::group(&mut w, &tc, meta.rate_hz);
+    }
+    if let Some(first) = range.renumbered_from {
+        w.group(EMOSHIFT, "EMOSHIFT", "emoshift's additions");
+        w.int(EMOSHIFT, "FIRST_FRAME", &words(first));
     }
     w.finish()
 }
