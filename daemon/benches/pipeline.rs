@@ -7,13 +7,21 @@
 //! the bare model again with the monitor page open (issue 17): after each frame the processing
 //! thread's tap, at 120 Hz on a 30 Hz schedule, so every 4th frame is copied and published to
 //! the board, as `serve` does while a page is open; against the first line, its cost per frame.
+//! And the bare model while `/record/start` records the edited stream and the raw input to C3D
+//! (issue 36): the processing thread's share of a crash-safe recording (each frame encoded and
+//! handed to the file's own thread; the writes, syncs and header counts happen there). Its
+//! files go to /dev/shm where there is one, each sample's deleted after it, so the bench
+//! measures the frame path rather than the disk.
 
 use std::net::SocketAddr;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use daemon::serve::monitor::Board;
 use daemon::serve::sinks::osc::encode::{EncodeOnly, Profiles};
+use daemon::serve::sinks::recording::Recorder;
 use daemon::serve::sources::osc::OscDemux;
 use daemon::serve::sources::InputCounters;
 use engine::monitor::MonitorTap;
@@ -29,15 +37,17 @@ use protocol::{encode_frame_into, FrameBuf, Profile};
 struct Outputs {
     compact: EncodeOnly,
     tap: Option<(MonitorTap, Arc<Board>)>,
+    recorder: Recorder,
 }
 
 impl Sink for Outputs {
     fn needs(&self) -> Needs {
-        self.compact.needs()
+        self.compact.needs().or(self.recorder.needs())
     }
 
     fn handle_frame(&mut self, frame: &Processed<'_>) {
         self.compact.handle_frame(frame);
+        self.recorder.handle_frame(frame);
         if let Some((tap, board)) = &mut self.tap {
             let now_us = frame.frame_number() as u64 * 8_333;
             if board.watched() {
@@ -49,7 +59,28 @@ impl Sink for Outputs {
     }
 }
 
-fn bench_model(c: &mut Criterion, name: &str, model: IcaModel, monitor: bool) {
+/// What runs beside the compact encoding.
+#[derive(Clone, Copy, PartialEq)]
+enum Beside {
+    Nothing,
+    MonitorPage,
+    Recording,
+}
+
+/// Where a recording bench writes: memory where the system has a tmpfs.
+fn scratch() -> tempfile::TempDir {
+    let shm = Path::new("/dev/shm");
+    let builder = tempfile::Builder::new();
+    let dir = if shm.is_dir() {
+        builder.tempdir_in(shm)
+    } else {
+        builder.tempdir()
+    };
+    dir.expect("a scratch folder")
+}
+
+fn bench_model(c: &mut Criterion, name: &str, model: IcaModel, beside: Beside) {
+    let monitor = beside == Beside::MonitorPage;
     let model = Arc::new(model);
     let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
     let mut demux = OscDemux::new(109, Arc::new(InputCounters::named("osc")));
@@ -59,6 +90,7 @@ fn bench_model(c: &mut Criterion, name: &str, model: IcaModel, monitor: bool) {
     let mut outputs = Outputs {
         compact: EncodeOnly::new(Profiles::default().with(Profile::Compact), 109),
         tap: monitor.then(|| (MonitorTap::new(30.0), Arc::clone(&board))),
+        recorder: Recorder::new(),
     };
     let labels = labels_datagram(&model).expect("valid labels");
     demux.handle_datagram(peer, &labels, &mut |_| {});
@@ -74,16 +106,39 @@ fn bench_model(c: &mut Criterion, name: &str, model: IcaModel, monitor: bool) {
         })
         .collect();
     let mut n: i32 = 0;
-    c.bench_function(name, |b| {
-        b.iter(|| {
-            let d = &mut datagrams[n as usize % 120];
-            // Frame numbers must increase or the stream drops the frame as stale.
-            d[24..28].copy_from_slice(&n.to_be_bytes());
-            n += 1;
-            demux.handle_datagram(peer, d, &mut |f| pipeline.handle_frame(f, &mut outputs));
-            outputs.compact.bytes
-        })
-    });
+    let mut frame = |outputs: &mut Outputs| {
+        let d = &mut datagrams[n as usize % 120];
+        // Frame numbers must increase or the stream drops the frame as stale.
+        d[24..28].copy_from_slice(&n.to_be_bytes());
+        n += 1;
+        demux.handle_datagram(peer, d, &mut |f| pipeline.handle_frame(f, outputs));
+        outputs.compact.bytes
+    };
+    if beside == Beside::Recording {
+        // Each sample records to new files (edited and raw C3D), closed and deleted after it:
+        // a sample's frames are timed, the start and the close are not.
+        c.bench_function(name, |b| {
+            b.iter_custom(|iters| {
+                let dir = scratch();
+                let file = |name: &str| -> PathBuf { dir.path().join(name) };
+                let raw = file("raw.c3d");
+                outputs
+                    .recorder
+                    .start_at(&file("edited.c3d"), Some(&raw))
+                    .expect("a recording starts");
+                let start = Instant::now();
+                for _ in 0..iters {
+                    criterion::black_box(frame(&mut outputs));
+                }
+                let took = start.elapsed();
+                assert!(outputs.recorder.error().is_none(), "the recording stopped");
+                std::mem::take(&mut outputs.recorder).finish();
+                took
+            })
+        });
+    } else {
+        c.bench_function(name, |b| b.iter(|| frame(&mut outputs)));
+    }
     let mut tap = MonitorTap::new(30.0);
     if monitor {
         // The tap's own work, every call due: one snapshot copied and published.
@@ -109,13 +164,19 @@ fn whole_frame_path(c: &mut Criterion) {
         c,
         "pipeline 109 markers m=20 compact",
         random_model(109, 20, 1),
-        false,
+        Beside::Nothing,
     );
     bench_model(
         c,
         "pipeline 109 markers m=20 compact, monitor page open",
         random_model(109, 20, 1),
-        true,
+        Beside::MonitorPage,
+    );
+    bench_model(
+        c,
+        "pipeline 109 markers m=20 compact, recording edited + raw C3D",
+        random_model(109, 20, 1),
+        Beside::Recording,
     );
     let mut checked = random_model(109, 20, 1);
     let centre = checked
@@ -138,7 +199,7 @@ fn whole_frame_path(c: &mut Criterion) {
         c,
         "pipeline 109 markers m=20 compact, glitch checks",
         checked,
-        false,
+        Beside::Nothing,
     );
 }
 

@@ -76,6 +76,17 @@ impl Recorder {
         Ok(())
     }
 
+    /// Starts a recording as `/record/start PATH [RAW]` does, without a controller to tell
+    /// (benches and tools that drive a [`Recorder`] directly).
+    ///
+    /// # Errors
+    /// Why the recording cannot start (the path exists, its folder does not, an unknown
+    /// extension), as `/record/start` would answer.
+    pub fn start_at(&mut self, path: &Path, raw: Option<&Path>) -> Result<(), String> {
+        self.start(path, raw, false, None)
+            .map_err(|refusal| refusal.to_string())
+    }
+
     /// Stops the recording; `reply` is answered once its files are complete.
     pub(crate) fn stop(&mut self, reply: oneshot::Sender<Reply>) {
         match self.running.take() {
