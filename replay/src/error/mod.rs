@@ -85,6 +85,15 @@ pub enum ReadError {
         /// 1-based line number.
         line: usize,
     },
+    /// A text line longer than any take's (a binary file, or text without newlines): refused
+    /// before it is held in memory.
+    #[error("line {line} is over {max_mib} MiB without a newline: not a TRC or CSV take (is the extension right?)")]
+    LineTooLong {
+        /// 1-based line number.
+        line: usize,
+        /// The longest line read, MiB.
+        max_mib: u64,
+    },
     /// The input ended before a required header line.
     #[error("input ends at line {line}, expected {expected}")]
     UnexpectedEnd {

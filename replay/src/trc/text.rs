@@ -3,9 +3,13 @@
 //! They live under `trc` only because a module of the text formats' own would sit outside the
 //! paths these readers own; nothing here is TRC specific.
 
-use std::io::BufRead;
+use std::io::{BufRead, Read};
 
 use crate::error::{ReadError, WriteError};
+
+/// The longest text line read, MiB: a row of 100,000 markers is about 4 MiB. A longer line (a
+/// binary file, or text without newlines) is an error, not a buffer that grows with the file.
+const MAX_LINE_MIB: u64 = 16;
 
 /// Reads a text file line by line, numbering lines from 1 and stripping `\n` or `\r\n`.
 ///
@@ -44,10 +48,21 @@ impl<R: BufRead> Lines<R> {
         // Reuse the previous line's allocation for the raw bytes.
         let mut bytes = std::mem::take(&mut self.text).into_bytes();
         bytes.clear();
-        if self.input.read_until(b'\n', &mut bytes)? == 0 {
+        let most = MAX_LINE_MIB << 20;
+        if (&mut self.input)
+            .take(most + 1)
+            .read_until(b'\n', &mut bytes)?
+            == 0
+        {
             return Ok(None);
         }
         self.number += 1;
+        if bytes.len() as u64 > most {
+            return Err(ReadError::LineTooLong {
+                line: self.number,
+                max_mib: MAX_LINE_MIB,
+            });
+        }
         self.terminated = bytes.last() == Some(&b'\n');
         if self.terminated {
             bytes.pop();

@@ -267,3 +267,31 @@ fn empty_takes_round_trip_with_their_first_frame_in_trc() {
         (0, take.rate_hz, 1)
     );
 }
+
+/// A file without newlines (a binary renamed .csv, a comment that never ends) is refused at
+/// 16 MiB, not held whole however large it is: by the readers, and by `repair`'s inspection.
+#[test]
+fn a_line_without_end_is_refused_at_16_mib() {
+    use std::io::Read;
+    let endless = |first: u8| std::io::repeat(first).take((16 << 20) + 1);
+    for (what, got) in [
+        ("csv comment", csv::read(endless(b'#'))),
+        ("csv header", csv::read(endless(b'f'))),
+        ("trc header", trc::read(endless(b'P'))),
+    ] {
+        match got {
+            Err(ReadError::LineTooLong {
+                line: 1,
+                max_mib: 16,
+            }) => {}
+            other => panic!("{what}: {other:?}"),
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("comments.csv");
+    let mut file = std::fs::File::create(&path).unwrap();
+    std::io::copy(&mut endless(b'#'), &mut file).unwrap();
+    let err = replay::repair::inspect(&path).expect_err("not a take");
+    let cause = std::error::Error::source(&err).map(ToString::to_string);
+    assert!(cause.unwrap_or_default().contains("over 16 MiB"), "{err:?}");
+}
