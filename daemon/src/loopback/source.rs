@@ -7,6 +7,7 @@
 //! and spinning a whole period would burn a core for nothing. The bench passes zero: on a small
 //! machine a spinning sender takes a core from the daemon it measures.
 
+use std::collections::HashMap;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -90,6 +91,23 @@ pub fn play_take(
         source.send_due(take, due).map(|()| true)
     })?;
     Ok(pacer.summary().late_frames)
+}
+
+/// Replays `total` frames of `take` to `to` at its rate (looping): when each frame number
+/// went, and how many the pacer sent late.
+///
+/// # Errors
+/// As [`play_take`].
+pub fn play_take_timed(
+    take: &Take,
+    to: SocketAddr,
+    total: usize,
+) -> Result<(HashMap<i64, Instant>, u64)> {
+    let mut sent = HashMap::with_capacity(total);
+    let late = play_take(take, to, Some(total), &AtomicBool::new(false), |n| {
+        sent.insert(n, Instant::now());
+    })?;
+    Ok((sent, late))
 }
 
 /// Sleeps until `spin` before `deadline`, then spins; returns early on a stop request.

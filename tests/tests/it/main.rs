@@ -2,6 +2,7 @@
 
 mod control;
 mod crash;
+mod demo;
 mod edit;
 mod faults;
 mod monitor;

@@ -3,33 +3,21 @@
 //! page, the take looping until Ctrl-C.
 
 use std::collections::HashMap;
-use std::net::SocketAddr;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
-use hdrhistogram::Histogram;
-use ica_core::model::{IcaModel, SpaceTarget};
+use ica_core::model::IcaModel;
 use protocol::{Control, Profile};
 use replay::Take;
 
 use super::STREAM_S;
 use crate::loopback::daemon::loopback_config;
-use crate::loopback::source::play_take;
-use crate::loopback::{ControlClient, Daemon, Received, Receiver};
-use crate::serve::stats::Stats;
-
-/// What the client saw of one frame: its number, when, the emotion state, and the received
-/// markers' coordinates on the emotion axes (to show the sweep in model units).
-struct Seen {
-    number: i32,
-    at: Instant,
-    target: String,
-    amount: f32,
-    emotion: Option<Vec<f32>>,
-}
+use crate::loopback::probe::{emotion_probe, latency_us, windows, Seen};
+use crate::loopback::source::{play_take, play_take_timed};
+use crate::loopback::{block_on, ControlClient, Daemon, Receiver};
 
 /// The live run's measurements.
 pub(super) struct Live {
@@ -38,46 +26,6 @@ pub(super) struct Live {
     rate_hz: f64,
     late_sends: u64,
     sweep: Vec<String>,
-}
-
-/// A current-thread runtime for the demo's client side (the daemon has its own).
-fn block_on<T>(work: impl std::future::Future<Output = Result<T>>) -> Result<T> {
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build();
-    runtime.context("cannot start the runtime")?.block_on(work)
-}
-
-/// A client of the compact profile that projects what it receives onto the emotion axes.
-fn seeing(model: &IcaModel) -> impl FnMut(&mut Vec<Seen>, &Received<'_>) + Send + 'static {
-    let mut processor = engine::frame::FrameProcessor::new(model);
-    let (markers, mut u) = (model.markers(), vec![0.0f32; model.components()]);
-    let space = SpaceTarget::new(model.emotion(), model.components());
-    let mut missing = Vec::with_capacity(markers);
-    move |seen, r| {
-        let Some((header, frame)) = r.frame else {
-            return;
-        };
-        missing.clear();
-        missing.extend((0..frame.marker_count()).map(|i| frame.is_missing(i)));
-        let complete = space.dims() > 0 && missing.len() == markers;
-        let emotion = complete
-            .then(|| processor.project(frame.positions(), &missing, &mut u).ok())
-            .flatten()
-            .map(|_| {
-                let mut at = vec![0.0f32; space.dims()];
-                space.coordinates_into(&u, &mut at);
-                at
-            });
-        let state = r.state.as_ref();
-        seen.push(Seen {
-            number: header.frame_number,
-            at: r.at,
-            target: state.map_or_else(String::new, |s| s.target.to_string()),
-            amount: state.map_or(0.0, |s| s.amount),
-            emotion,
-        });
-    }
 }
 
 /// The daemon on loopback, a subscribed client, the take replayed into it at its rate (looped
@@ -98,7 +46,7 @@ pub(super) fn stream(model: &IcaModel, take: Arc<Take>, sweep: &[String]) -> Res
                 "client: subscribed {} with the compact profile",
                 client.addr()?
             );
-            let seen = client.collect(None, Vec::new(), seeing(model));
+            let seen = client.collect(None, Vec::new(), emotion_probe(model));
             let frames = (STREAM_S * rate_hz).ceil() as usize;
             let total = if sweep.is_empty() {
                 frames.min(take.n_frames())
@@ -109,7 +57,7 @@ pub(super) fn stream(model: &IcaModel, take: Arc<Take>, sweep: &[String]) -> Res
             start_sweep(&control, sweep, share).await?;
             let sender = tokio::task::spawn_blocking({
                 let to = daemon.frames;
-                move || send_timed(&take, to, total)
+                move || play_take_timed(&take, to, total)
             });
             for target in sweep.iter().skip(1) {
                 tokio::time::sleep(share).await;
@@ -149,15 +97,6 @@ async fn start_sweep(control: &ControlClient, sweep: &[String], share: Duration)
     Ok(())
 }
 
-/// Replays `total` frames of `take` to `to`: when each frame number went, and how many late.
-fn send_timed(take: &Take, to: SocketAddr, total: usize) -> Result<(HashMap<i64, Instant>, u64)> {
-    let mut sent = HashMap::with_capacity(total);
-    let late = play_take(take, to, Some(total), &AtomicBool::new(false), |n| {
-        sent.insert(n, Instant::now());
-    })?;
-    Ok((sent, late))
-}
-
 pub(super) fn summary(
     live: &Live,
     model: &IcaModel,
@@ -169,14 +108,9 @@ pub(super) fn summary(
     let share = 100.0 * lost as f64 / sent.max(1) as f64;
     let (rate, late) = (live.rate_hz, live.late_sends);
     crate::out!("frames: {sent} sent at {rate} Hz, {received} received, {lost} lost ({share:.2} %), {late} sent late");
-    let mut latency_us: Histogram<u64> = Stats::histogram();
-    for s in &live.seen {
-        if let Some(at) = live.sent.get(&i64::from(s.number)) {
-            Stats::record(&mut latency_us, s.at.duration_since(*at).as_micros() as u64);
-        }
-    }
-    let q = |q: f64| latency_us.value_at_quantile(q);
-    let (p50, p99, p999, max) = (q(0.5), q(0.99), q(0.999), latency_us.max());
+    let latency = latency_us(&live.sent, &live.seen);
+    let q = |q: f64| latency.value_at_quantile(q);
+    let (p50, p99, p999, max) = (q(0.5), q(0.99), q(0.999), latency.max());
     crate::out!("latency source -> daemon -> client: p50 {p50} us, p99 {p99} us, p99.9 {p999} us, max {max} us");
     if !live.sweep.is_empty() {
         print_sweep(live, model)?;
@@ -211,39 +145,15 @@ fn print_sweep(live: &Live, model: &IcaModel) -> Result<()> {
     let axes = model.emotion().axis_names().join(" ");
     let sweep = live.sweep.join(" -> ");
     crate::out!("emotion sweep {sweep} as the client saw it (emotion axes {axes} of the received markers, 0.5 s means):");
-    let first = live
-        .sent
-        .values()
-        .min()
-        .copied()
-        .unwrap_or_else(Instant::now);
-    let t = |s: &Seen| s.at.saturating_duration_since(first).as_secs_f64();
-    let end = live.seen.last().map_or(0.0, t);
-    let mut t0 = 0.0;
-    while t0 < end {
-        let window: Vec<&Seen> = live
-            .seen
-            .iter()
-            .filter(|s| (t0..t0 + 0.5).contains(&t(s)))
-            .collect();
-        let values: Vec<&Vec<f32>> = window.iter().filter_map(|s| s.emotion.as_ref()).collect();
-        if let (Some(last), false) = (window.last(), values.is_empty()) {
-            let mean: Vec<String> = (0..values[0].len())
-                .map(|j| {
-                    format!(
-                        "{:+.3}",
-                        values.iter().map(|v| v[j]).sum::<f32>() / values.len() as f32
-                    )
-                })
-                .collect();
-            let (target, amount) = (&last.target, last.amount);
-            crate::out!(
-                "  t {t0:4.1}-{:4.1} s  target {target:<10} amount {amount:.2}  emotion {}",
-                t0 + 0.5,
-                mean.join(" ")
-            );
-        }
-        t0 += 0.5;
+    let first = live.sent.values().min().copied();
+    for w in windows(&live.seen, first.unwrap_or_else(Instant::now), 0.5) {
+        let mean: Vec<String> = w.emotion.iter().map(|v| format!("{v:+.3}")).collect();
+        let (t0, target, amount) = (w.from_s, &w.target, w.amount);
+        crate::out!(
+            "  t {t0:4.1}-{:4.1} s  target {target:<10} amount {amount:.2}  emotion {}",
+            t0 + 0.5,
+            mean.join(" ")
+        );
     }
     Ok(())
 }
