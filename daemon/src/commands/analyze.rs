@@ -124,6 +124,9 @@ fn print_table(report: &analysis::Report) -> Result<()> {
     if !report.emotion_note.is_empty() {
         crate::out!("note: {}", report.emotion_note);
     }
+    for line in &report.advice {
+        crate::out!("warning: {line}");
+    }
     match &report.space {
         Some(space) if space.components.len() > 1 => {
             for (name, point) in &space.points {

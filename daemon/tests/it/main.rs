@@ -13,6 +13,7 @@ mod emotion_captures;
 mod emotion_cli;
 mod emotion_space;
 mod emotion_variants;
+mod issue_37;
 mod natnet_alloc;
 mod pipeline_alloc;
 mod realdata;

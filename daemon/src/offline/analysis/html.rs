@@ -193,6 +193,19 @@ fn level_items(report: &Report) -> String {
         .collect()
 }
 
+/// What the session lacks (as `analyze` prints it), as a list; empty when nothing.
+fn advice_section(report: &Report) -> String {
+    if report.advice.is_empty() {
+        return String::new();
+    }
+    let items: String = report
+        .advice
+        .iter()
+        .map(|line| format!("<li>{}</li>", esc(line)))
+        .collect();
+    format!("<p><b>What the session lacks</b></p><ul class=\"advice\">{items}</ul>\n")
+}
+
 /// What the analysis says of the emotion component(s).
 fn emotion_note(report: &Report) -> String {
     if report.emotion_note.is_empty() {
@@ -228,7 +241,7 @@ markers towards the full reconstruction (|d_region,i|, Eq. 4 of the method).
 Bars are coloured by the role given.</p>
 <img src="components.svg" alt="bar charts of d_emotion, d_mouth, d_eyebrows and d_eyelids per component">
 <p>{note}</p>
-<h2>Components over time</h2>
+{advice}<h2>Components over time</h2>
 <p>Each row is one component over takes that alternate between the two most different emotions
 (shaded backgrounds). The emotion component jumps between levels when the emotion changes; speech
 components follow the words.</p>
@@ -248,6 +261,7 @@ largest; else other.</p>
         manifest = report.manifest,
         quality = quality_section(&report.quality),
         space = space_section(report, &levels),
+        advice = advice_section(report),
         m = report.components.len(),
         pairs = report.pairs.len(),
         r1 = t.emotion_peak_ratio,

@@ -13,6 +13,7 @@
 //! per-pair summaries between sentences ([`SessionStats`]), so memory does not grow with the
 //! session (issue 18); [`analyze`] is the same accumulator over takes already in memory.
 
+pub mod advice;
 mod html;
 mod map;
 pub mod space;
@@ -41,6 +42,12 @@ pub const ROLE_REGIONS: [(&str, Role); 3] = [
     ("eyebrows", Role::Eyebrows),
     ("eyelids", Role::Eyelids),
 ];
+
+/// Sentences to record in each emotion of a calibration session: with fewer, emotions that
+/// differ are found indistinct and emotion components miss the test (the last wave saw 8
+/// sentences per emotion work and 3 fail). `analyze` advises it when a session has fewer. How
+/// the figure was measured, and the curve behind it: docs/session.md.
+pub const MIN_SENTENCES_PER_EMOTION: usize = 8;
 
 /// DTW band as a share of the longer take of a pair: the generator's warps stay within ±20 %.
 pub const DTW_BAND_SHARE: f64 = 0.25;
@@ -124,6 +131,12 @@ pub struct Report {
     pub regions: BTreeMap<String, Vec<String>>,
     /// The model's own quality report (head decision, stability, residuals, warnings).
     pub quality: ica_core::quality::ModelQuality,
+    /// Components that nearly passed the emotion test.
+    pub near_misses: Vec<advice::NearMiss>,
+    /// The fewest sentences any emotion was recorded with.
+    pub sentences_per_emotion: usize,
+    /// What the session lacks, one line each, as `analyze` prints them (see [`advice::lines`]).
+    pub advice: Vec<String>,
 }
 
 /// Inputs of an analysis.

@@ -16,6 +16,7 @@ use ica_core::interpret::{
 };
 use ica_core::model::Role;
 
+use super::advice;
 use super::space::{self, EmotionSpace, TakeLevel};
 use super::{ComponentReport, Inputs, PairSummary, Report, TakeSummary};
 use super::{DTW_BAND_SHARE, ROLE_REGIONS};
@@ -196,7 +197,13 @@ impl SessionStats {
                 emotion_effect: space.as_ref().map(|s| s.effects[k]),
             })
             .collect();
+        let takes: Vec<TakeSummary> = self.takes.into_iter().map(|t| t.summary).collect();
+        let near_misses = space.as_ref().map(advice::near_misses).unwrap_or_default();
+        let sentences_per_emotion = advice::sentences_per_emotion(&takes);
         Ok(Report {
+            advice: advice::lines(space.as_ref(), &near_misses, sentences_per_emotion),
+            near_misses,
+            sentences_per_emotion,
             model: inputs.model_path.display().to_string(),
             manifest: inputs.manifest_path.display().to_string(),
             components,
@@ -206,7 +213,7 @@ impl SessionStats {
             levels: levels_of(space.as_ref()),
             space,
             pairs: self.pairs.into_iter().map(|(_, p)| p).collect(),
-            takes: self.takes.into_iter().map(|t| t.summary).collect(),
+            takes,
             thresholds: rules,
             dtw_band_share: DTW_BAND_SHARE,
             regions: region_labels(model, regions),

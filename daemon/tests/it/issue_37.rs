@@ -1,0 +1,42 @@
+//! Issue 37, the first hour on a stage: what a newcomer met, pinned from the command line.
+
+use daemon::offline::analysis::MIN_SENTENCES_PER_EMOTION;
+
+use crate::common::{ok, p};
+
+/// A session of 3 sentences in 3 emotions: `analyze` says on the terminal what the session
+/// lacks, with the number of sentences to record.
+#[test]
+fn analyze_on_a_small_session_advises_more_sentences() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let session = dir.path().join("s");
+    ok(&[
+        "synth",
+        "--out",
+        p(&session),
+        "--seed",
+        "3",
+        "--sentences",
+        "3",
+        "--emotions",
+        "neutral,happy,angry",
+    ]);
+    let manifest = session.join("session.toml");
+    let model = dir.path().join("model.json");
+    ok(&["train", "--manifest", p(&manifest), "--out", p(&model)]);
+    let out = ok(&[
+        "analyze",
+        "--model",
+        p(&model),
+        "--manifest",
+        p(&manifest),
+        "--out",
+        p(&dir.path().join("report")),
+    ]);
+    let advice = format!(
+        "warning: record at least {MIN_SENTENCES_PER_EMOTION} sentences per emotion; you have 3"
+    );
+    assert!(out.contains(&advice), "no {advice:?} in:\n{out}");
+    let html = std::fs::read_to_string(dir.path().join("report/report.html")).expect("report");
+    assert!(html.contains("What the session lacks"), "{html}");
+}
