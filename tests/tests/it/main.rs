@@ -5,6 +5,7 @@ mod crash;
 mod demo;
 mod edit;
 mod faults;
+mod issue_37;
 mod monitor;
 mod natnet;
 mod regression_30;

@@ -19,7 +19,7 @@ const PERIOD: Duration = Duration::from_micros(8_333);
 
 /// A free loopback port (bound, then released).
 /// A stand-in describing one markerset "Face" with the model's marker names.
-fn motive(m: &ModelFile, command: SocketAddr, multicast: Option<SocketAddr>) -> Motive {
+pub(super) fn motive(m: &ModelFile, command: SocketAddr, multicast: Option<SocketAddr>) -> Motive {
     let defs = ModelDefs {
         markersets: vec![MarkersetDef {
             name: "Face".into(),
@@ -69,7 +69,7 @@ fn frame(m: &ModelFile, n: usize) -> (Vec<[f32; 3]>, Smpte) {
 }
 
 /// Streams frames `range` at 120 Hz from the stand-in.
-async fn stream(m: &ModelFile, server: &mut Motive, range: std::ops::Range<usize>) {
+pub(super) async fn stream(m: &ModelFile, server: &mut Motive, range: std::ops::Range<usize>) {
     let mut tick = tokio::time::interval(PERIOD);
     let mut f = FrameOfData::default();
     for n in range {

@@ -263,14 +263,47 @@ impl Pipeline {
         if self.streams.len() >= MAX_SOURCES {
             return format!("the daemon already runs {MAX_SOURCES} streams");
         }
-        let model = &self.model.labels()[..self.model.labels().len().min(4)];
-        format!(
+        let all = self.model.labels();
+        let model = &all[..all.len().min(4)];
+        let why = format!(
             "none of its {} markers ({}) is a marker of the model, whose markers start {}",
             labels.len(),
             short_list(labels, 4),
             model.join(", ")
-        )
+        );
+        match prefix_hint(labels, all) {
+            Some(hint) => format!("{why}; {hint}"),
+            None => format!(
+                "{why}; train the model on takes named as this source names its markers, or \
+                 rename them at the source"
+            ),
+        }
     }
+}
+
+/// What to try when `labels` would match `model` without a prefix (Motive's `Face:HeadFront`
+/// or `Face_HeadFront` against a model trained on `HeadFront`); `None` when it would not.
+fn prefix_hint(labels: &[String], model: &[String]) -> Option<String> {
+    for sep in [':', '_'] {
+        let matched = labels
+            .iter()
+            .filter_map(|l| l.split_once(sep))
+            .filter(|(_, marker)| model.iter().any(|m| m == marker))
+            .count();
+        if matched == 0 {
+            continue;
+        }
+        let prefix = labels
+            .iter()
+            .find_map(|l| l.split_once(sep))
+            .map_or(String::new(), |(asset, _)| format!("{asset}{sep}"));
+        return Some(format!(
+            "without the prefix {prefix:?} {matched} of them are the model's: over NatNet, serve \
+             with --natnet-names marker (natnet_names = \"marker\"); over OSC, send the names \
+             without it"
+        ));
+    }
+    None
 }
 
 #[cfg(test)]

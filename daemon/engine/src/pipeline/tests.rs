@@ -321,3 +321,26 @@ fn a_frame_too_occluded_to_estimate_goes_out_as_seen() {
         "the face comes back with the markers"
     );
 }
+
+/// Issue 37: a model trained on `HeadFront` meeting Motive's `Face:HeadFront` says to strip
+/// the prefix, naming both sides.
+#[test]
+fn a_prefixed_source_is_told_to_strip_the_prefix() {
+    let model = Arc::new(random_model(MARKERS, 4, 11));
+    let mut p = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let names: Vec<String> = model.labels().iter().map(|l| format!("Face:{l}")).collect();
+    let xyz = vec![1.0; MARKERS * 3];
+    let mut src = Src::named(peer(), names);
+    assert!(src.send(&mut p, &xyz, 1).is_empty(), "no stream");
+    let why = p.poll_refusal().expect("told why").why;
+    assert!(why.contains("(Face:"), "the source's names: {why}");
+    assert!(
+        why.contains("whose markers start"),
+        "the model's names: {why}"
+    );
+    assert!(
+        why.contains("without the prefix \"Face:\" 12 of them are the model's")
+            && why.contains("--natnet-names marker"),
+        "{why}"
+    );
+}

@@ -33,7 +33,7 @@ use super::frames::{LayoutIds, NatNetFrames, NatNetLayout};
 use super::status::NatNetStatus;
 use super::wire::{join_multicast, models_changed, recv};
 use crate::serve::net::bind_receiver_std;
-use crate::serve::sources::{Arrival, FrameSink, InputCounters};
+use crate::serve::sources::{Answer, Arrival, FrameSink, InputCounters};
 
 /// How often the owner hears the status even when nothing happens.
 const STATUS_EVERY: Duration = Duration::from_secs(1);
@@ -85,6 +85,9 @@ pub struct Link {
     /// `FrameRate` is to be asked (after a connect) / has been asked and not answered.
     rate: (bool, bool),
     announced_rate_hz: Option<f64>,
+    /// Logs why a markerset's frames make no stream (a NatNet server cannot hear it), as the
+    /// OSC frame socket logs and answers it.
+    answer: Arc<Answer>,
 }
 
 impl Link {
@@ -120,6 +123,7 @@ impl Link {
             status,
             rate: (false, false),
             announced_rate_hz: None,
+            answer: Arc::new(Answer::new(None)),
             config,
         };
         if let Some(addr) = link.config.data {
@@ -211,6 +215,7 @@ impl Link {
         self.status.frames += 1;
         let layout = &session.layout;
         let counters = &self.counters;
+        let answer = &self.answer;
         let decoded = self.frames.handle_datagram(
             session.server,
             bytes,
@@ -221,7 +226,7 @@ impl Link {
                 let arrival = Arrival {
                     received: now,
                     captured: session.local_instant(frame.frame.header().capture_time_us),
-                    answer: None,
+                    answer: Some(Arc::clone(answer)),
                     announced_rate_hz: session.announced_rate_hz,
                 };
                 on_frame(frame, &arrival);

@@ -1,0 +1,81 @@
+//! Issue 37, the first hour on a stage: a NatNet name mismatch in `serve` warns, naming both
+//! sides and the flag that fixes it.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use super::natnet::{motive, stream};
+use super::support::*;
+
+/// Lines of `child`'s stderr, each with when it came, gathered on a thread.
+fn stderr_lines(child: &mut Child) -> Arc<Mutex<Vec<(Instant, String)>>> {
+    let lines = Arc::new(Mutex::new(Vec::new()));
+    let err = child.stderr.take().expect("stderr piped");
+    let into = Arc::clone(&lines);
+    std::thread::spawn(move || {
+        for line in BufReader::new(err).lines().map_while(Result::ok) {
+            into.lock().expect("lines").push((Instant::now(), line));
+        }
+    });
+    lines
+}
+
+fn signal(child: &Child, sig: &str) {
+    let kill = Command::new("kill")
+        .args([sig, &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(kill.success());
+}
+
+fn text(lines: &Mutex<Vec<(Instant, String)>>) -> String {
+    let lines = lines.lock().expect("lines");
+    lines.iter().map(|(_, l)| format!("{l}\n")).collect()
+}
+
+/// Motive names the markers `Face:<marker>`, the model knows `<marker>`: `serve` says so at
+/// WARN with both sides' names and the flag to pass.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_natnet_name_mismatch_in_serve_warns_with_both_sides_and_the_fix() {
+    let m = model_file(37);
+    let mut server = motive(&m, "127.0.0.1:0".parse().expect("addr"), None);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"))
+        .arg("serve")
+        .arg("--model")
+        .arg(&m.path)
+        .args(["--listen", "127.0.0.1:0", "--control", "127.0.0.1:0"])
+        .args(["--natnet", &server.command_addr().to_string()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary starts");
+    let lines = stderr_lines(&mut child);
+    for _ in 0..100 {
+        if server.clients() > 0 {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    stream(&m, &mut server, 0..120).await;
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    signal(&child, "-TERM");
+    let _ = tokio::task::spawn_blocking(move || child.wait()).await;
+    server.stop();
+    let err = text(&lines);
+    let warn = err
+        .lines()
+        .find(|l| l.contains("WARN") && l.contains("--natnet-names marker"))
+        .unwrap_or_else(|| panic!("no WARN suggesting --natnet-names marker in:\n{err}"));
+    let first = &m.model.labels()[0];
+    assert!(
+        warn.contains(&format!("Face:{first}")),
+        "the source's names: {warn}"
+    );
+    assert!(
+        warn.contains("whose markers start"),
+        "the model's names: {warn}"
+    );
+}
