@@ -71,9 +71,17 @@ pub(crate) fn run(args: &RecordArgs) -> Result<()> {
             }
         })?;
     let Some(c) = captured else {
-        crate::out!("no frames arrived; nothing written to {}", out.display());
-        return Ok(());
+        anyhow::bail!(
+            "no frames arrived; nothing written to {}: check that the source streams to this \
+             host (see the lines above)",
+            out.display()
+        );
     };
+    print_captured(&c)
+}
+
+/// The take's summary: file, frames, stream, gaps, rate, first timecode, streams left out.
+fn print_captured(c: &capture::take::Captured) -> Result<()> {
     crate::out!(
         "{}: {} frames of {} ({} markers), {} of them gaps; rate {} Hz ({})",
         c.summary.path.display(),

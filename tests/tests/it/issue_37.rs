@@ -1,5 +1,6 @@
 //! Issue 37, the first hour on a stage: a NatNet name mismatch in `serve` warns, naming both
-//! sides and the flag that fixes it.
+//! sides and the flag that fixes it; a wrong `--performer` in `record` says which marker sets
+//! the server has, and exits non-zero when nothing was written.
 
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
@@ -78,4 +79,49 @@ async fn a_natnet_name_mismatch_in_serve_warns_with_both_sides_and_the_fix() {
         warn.contains("whose markers start"),
         "the model's names: {warn}"
     );
+}
+
+/// `record --natnet --performer face` while the server streams `Face`: told within two
+/// seconds of the first frame, and a non-zero exit with nothing written after Ctrl-C.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_wrong_performer_is_named_at_once_and_exits_non_zero() {
+    let m = model_file(38);
+    let mut server = motive(&m, "127.0.0.1:0".parse().expect("addr"), None);
+    let out = m.dir.path().join("face.c3d");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"))
+        .args(["record", "--natnet", &server.command_addr().to_string()])
+        .args(["--natnet-names", "marker", "--performer", "face", "--out"])
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary starts");
+    let lines = stderr_lines(&mut child);
+    for _ in 0..100 {
+        if server.clients() > 0 {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    let first_frame = Instant::now();
+    stream(&m, &mut server, 0..300).await;
+    signal(&child, "-INT");
+    let done = tokio::task::spawn_blocking(move || child.wait())
+        .await
+        .expect("join")
+        .expect("the child ends");
+    server.stop();
+    let want = "no marker set 'face'; the server has: Face";
+    let told = lines
+        .lock()
+        .expect("lines")
+        .iter()
+        .find(|(_, l)| l.contains(want))
+        .map(|(at, _)| at.duration_since(first_frame));
+    let err = text(&lines);
+    let told = told.unwrap_or_else(|| panic!("no {want:?} in:\n{err}"));
+    assert!(told < Duration::from_secs(2), "told after {told:?}");
+    assert!(!done.success(), "exit status {done:?}:\n{err}");
+    assert!(!out.exists(), "nothing is written");
 }

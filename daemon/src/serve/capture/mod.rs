@@ -56,6 +56,8 @@ struct State {
     take: Take,
     last_frame: Option<Instant>,
     quiet_told: bool,
+    /// Whether the missing `--performer` was told.
+    wrong_told: bool,
     error: Option<anyhow::Error>,
 }
 
@@ -76,8 +78,15 @@ impl State {
         }
     }
 
-    /// A notice when nothing came for [`QUIET`] (once per quiet spell).
+    /// A notice when nothing came for [`QUIET`] (once per quiet spell), or when the stream
+    /// asked for is not among those that came (once).
     fn quiet_notice(&mut self, since: Instant, what: impl FnOnce() -> String) -> Option<String> {
+        if !self.wrong_told {
+            if let Some(line) = wrong_performer(&self.take) {
+                self.wrong_told = true;
+                return Some(line);
+            }
+        }
         let quiet_from = self.last_frame.unwrap_or(since);
         if self.quiet_told || quiet_from.elapsed() < QUIET {
             return None;
@@ -101,6 +110,7 @@ pub async fn run(
         take: Take::new(&config.out, config.performer.clone()),
         last_frame: None,
         quiet_told: false,
+        wrong_told: false,
         error: None,
     });
     let stop = shutdown.child_token();
@@ -135,7 +145,21 @@ pub async fn run(
         let _ = state.take.finish();
         return Err(e);
     }
+    if let Some(line) = wrong_performer(&state.take) {
+        anyhow::bail!("nothing written to {}: {line}", config.out.display());
+    }
     state.take.finish()
+}
+
+/// "no marker set 'face'; the server has: Face", when the `--performer` asked for names none
+/// of the streams that came.
+fn wrong_performer(take: &Take) -> Option<String> {
+    let (wanted, others) = take.wanted_missing()?;
+    Some(format!(
+        "no marker set '{wanted}'; the server has: {} (names are case-sensitive: pass one of \
+         them to --performer)",
+        others.join(", ")
+    ))
 }
 
 /// The OSC source on `addr` until `stop`, with a quiet notice while nothing comes.

@@ -119,6 +119,15 @@ impl Take {
         self.stream.as_ref().map(|s| s.0.as_str())
     }
 
+    /// The stream asked for and the streams seen instead, while the one asked for has not come
+    /// (a `--performer` that names no stream of the source); `None` otherwise.
+    pub fn wanted_missing(&self) -> Option<(&str, &[String])> {
+        match (&self.wanted, &self.stream) {
+            (Some(w), None) if !self.others.is_empty() => Some((w, &self.others)),
+            _ => None,
+        }
+    }
+
     /// Seconds of capture since the first frame (capture times, else arrival).
     pub fn seconds(&self) -> f64 {
         match (self.first, self.last) {
