@@ -22,6 +22,14 @@ pub struct ServeArgs {
     /// Control socket, IP:PORT [default: 127.0.0.1:9001].
     #[arg(long, value_name = "IP:PORT")]
     pub control: Option<String>,
+    /// Who may send control messages (and use the monitor page's controls): networks in CIDR
+    /// form, comma-separated, replacing the config's control_allow [default: loopback only].
+    #[arg(long, value_name = "CIDR,...", value_delimiter = ',')]
+    pub control_allow: Vec<String>,
+    /// Who may send frames: networks in CIDR form, comma-separated, replacing the config's
+    /// frames_allow [default: anyone].
+    #[arg(long, value_name = "CIDR,...", value_delimiter = ',')]
+    pub frames_allow: Vec<String>,
     /// Static subscriber HOST:PORT[:profile] (compact, flat-split, components); repeatable,
     /// replaces the config's list.
     #[arg(long, value_name = "HOST:PORT[:PROFILE]")]

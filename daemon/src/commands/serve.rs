@@ -35,6 +35,12 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if !args.send.is_empty() {
         raw.send = args.send.clone();
     }
+    if !args.control_allow.is_empty() {
+        raw.control_allow = Some(args.control_allow.clone());
+    }
+    if !args.frames_allow.is_empty() {
+        raw.frames_allow = Some(args.frames_allow.clone());
+    }
     if let Some(l) = args.lowpass {
         raw.lowpass_s = Some(l);
     }
@@ -83,6 +89,9 @@ fn natnet_flags(args: &ServeArgs, raw: &mut RawConfig) {
 
 pub(crate) fn run(args: &ServeArgs) -> Result<()> {
     let config = config(args)?;
+    for warning in config.exposure_warnings() {
+        tracing::warn!(target: "emoshift", "{warning}");
+    }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()

@@ -100,6 +100,15 @@ impl AllowList {
     pub fn allows(&self, ip: IpAddr) -> bool {
         self.0.is_empty() || self.0.iter().any(|c| c.contains(ip))
     }
+
+    /// Whether only this host may talk (every network within 127.0.0.0/8 or ::1).
+    pub fn loopback_only(&self) -> bool {
+        !self.0.is_empty()
+            && self.0.iter().all(|c| match c.net {
+                IpAddr::V4(n) => n.is_loopback() && c.prefix >= 8,
+                IpAddr::V6(n) => n.is_loopback() && c.prefix == 128,
+            })
+    }
 }
 
 impl fmt::Display for AllowList {

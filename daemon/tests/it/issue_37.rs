@@ -40,3 +40,27 @@ fn analyze_on_a_small_session_advises_more_sentences() {
     let html = std::fs::read_to_string(dir.path().join("report/report.html")).expect("report");
     assert!(html.contains("What the session lacks"), "{html}");
 }
+
+/// `--control-allow` and `--frames-allow` lie over their keys, checked as the keys are: a
+/// network that is not one is a usage error naming the key.
+#[test]
+fn serve_takes_the_allow_lists_as_flags() {
+    for (flag, key) in [
+        ("--control-allow", "control_allow"),
+        ("--frames-allow", "frames_allow"),
+    ] {
+        let out = crate::common::run(&[
+            "serve",
+            "--model",
+            "no-such-model.json",
+            flag,
+            "10.0.0.0/8,192.168.1.0/33",
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag}: {err}");
+        assert!(
+            err.contains(key) && err.contains("192.168.1.0/33"),
+            "{flag}: {err}"
+        );
+    }
+}

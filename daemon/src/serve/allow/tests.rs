@@ -34,3 +34,18 @@ fn the_default_control_list_is_loopback_and_empty_is_anyone() {
     assert!(!l.allows(ip("192.168.0.10")));
     assert!(AllowList::anyone().allows(ip("192.168.0.10")));
 }
+
+#[test]
+fn loopback_only_is_the_default_and_nothing_wider() {
+    assert!(AllowList::loopback().loopback_only());
+    assert!(AllowList::parse(&["127.0.0.1"])
+        .expect("ok")
+        .loopback_only());
+    assert!(!AllowList::anyone().loopback_only());
+    assert!(!AllowList::parse(&["127.0.0.0/8", "10.0.0.0/8"])
+        .expect("ok")
+        .loopback_only());
+    assert!(!AllowList::parse(&["0.0.0.0/0"])
+        .expect("ok")
+        .loopback_only());
+}

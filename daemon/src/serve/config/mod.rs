@@ -13,6 +13,7 @@ use serde::Deserialize;
 use super::allow::AllowList;
 pub use super::config_error::ConfigError;
 
+mod exposure;
 mod values;
 pub use values::parse_send;
 use values::{addr, check, check_token, performer, secret};
