@@ -2,7 +2,7 @@
 //!
 //! ```toml
 //! # session.toml
-//! rate_hz = 120
+//! rate_hz = 120           # required: the takes' rate
 //! [[take]]
 //! file = "s03_happy.c3d"   # relative to the manifest
 //! sentence = "s03"
@@ -51,6 +51,12 @@ pub enum SessionError {
         /// What is wrong with it.
         source: Box<SessionError>,
     },
+    /// The manifest has no `rate_hz`.
+    #[error(
+        "rate_hz is required: the takes' frame rate in Hz, e.g. `rate_hz = 120` above the first \
+         [[take]] (`emoshift info TAKE` shows a take's rate)"
+    )]
+    MissingRate,
     /// The frame rate is not positive and finite.
     #[error("rate_hz must be positive and finite, got {0}")]
     BadRate(f64),
@@ -140,7 +146,8 @@ pub struct SessionTake {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Session {
-    /// Frame rate of the takes.
+    /// Frame rate of the takes; required (the model's rate in `train` unless `--rate` says
+    /// otherwise).
     pub rate_hz: f64,
     /// The takes, in order.
     #[serde(rename = "take", default)]
@@ -157,7 +164,12 @@ impl Session {
     /// # Errors
     /// Malformed TOML, a missing or unknown field, or a failed [`Session::validate`].
     pub fn parse(text: &str) -> Result<Session, SessionError> {
-        let session: Session = toml::from_str(text)?;
+        let session: Session = toml::from_str(text).map_err(|e| {
+            match e.message().contains("missing field `rate_hz`") {
+                true => SessionError::MissingRate,
+                false => SessionError::Parse(e),
+            }
+        })?;
         session.validate()?;
         Ok(session)
     }

@@ -145,7 +145,8 @@ pub struct ConvertArgs {
 /// `emoshift train`.
 #[derive(Debug, Args)]
 pub struct TrainArgs {
-    /// Session manifest listing the takes (session.toml).
+    /// Session manifest listing the takes (session.toml: `rate_hz`, required, then
+    /// `[[take]]` tables with file, sentence, emotion).
     #[arg(long)]
     pub manifest: Option<PathBuf>,
     /// Take files (in addition to the manifest's).

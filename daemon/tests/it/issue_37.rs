@@ -5,7 +5,7 @@ use daemon::offline::analysis::MIN_SENTENCES_PER_EMOTION;
 use crate::common::{ok, p};
 
 /// A session of 3 sentences in 3 emotions: `analyze` says on the terminal what the session
-/// lacks, with the number of sentences to record.
+/// lacks, with the number of sentences to record; its one emotion direction is drawn as a line.
 #[test]
 fn analyze_on_a_small_session_advises_more_sentences() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -20,6 +20,8 @@ fn analyze_on_a_small_session_advises_more_sentences() {
         "3",
         "--emotions",
         "neutral,happy,angry",
+        "--emotion-dims",
+        "1",
     ]);
     let manifest = session.join("session.toml");
     let model = dir.path().join("model.json");
@@ -39,6 +41,17 @@ fn analyze_on_a_small_session_advises_more_sentences() {
     assert!(out.contains(&advice), "no {advice:?} in:\n{out}");
     let html = std::fs::read_to_string(dir.path().join("report/report.html")).expect("report");
     assert!(html.contains("What the session lacks"), "{html}");
+    // One emotion direction: the map is a line with its axis, not an empty plane.
+    let map = std::fs::read_to_string(dir.path().join("report/emotion_map.svg")).expect("map");
+    assert!(
+        map.contains("along the one emotion direction") && map.contains("class=\"axis\""),
+        "{map}"
+    );
+    assert_eq!(
+        map.matches("class=\"take\"").count(),
+        9,
+        "every take drawn: {map}"
+    );
 }
 
 /// `--control-allow` and `--frames-allow` lie over their keys, checked as the keys are: a

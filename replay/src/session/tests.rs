@@ -22,6 +22,13 @@ fn manifests_reject_bad_input_and_resolve_paths() {
         Session::parse("rate_hz = 120\n"),
         Err(SessionError::NoTakes)
     ));
+    let no_rate = missing.replace("rate_hz = 120\n", "") + "emotion = \"happy\"\n";
+    let err = Session::parse(&no_rate).expect_err("no rate");
+    assert!(matches!(err, SessionError::MissingRate), "{err}");
+    assert!(
+        err.to_string().contains("rate_hz = 120"),
+        "says what to write: {err}"
+    );
     let zero = missing.replace("120", "0") + "emotion = \"happy\"\n";
     assert!(matches!(
         Session::parse(&zero),

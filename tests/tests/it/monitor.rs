@@ -134,7 +134,7 @@ async fn the_page_steers_through_the_osc_path_and_sees_the_frames_it_changed() {
         r["error"]
             .as_str()
             .expect("why")
-            .contains("unknown emotion"),
+            .contains("unknown emotion \"furious\" (the model knows "),
         "{r}"
     );
     let sub_from_page = Control::Subscribe {

@@ -25,10 +25,12 @@ fn set_blend(
 ) -> Result<(), EditRefused> {
     let point = model.emotion().blend(weights).map_err(|e| match e {
         ica_core::model::BlendError::NoEmotion => EditRefused::NoEmotion,
-        ica_core::model::BlendError::UnknownEmotion { name, .. } => {
-            EditRefused::UnknownEmotion { name }
+        ica_core::model::BlendError::UnknownEmotion { name, known } => {
+            EditRefused::UnknownEmotion { name, known }
         }
-        ica_core::model::BlendError::BadWeight { name, .. } => EditRefused::UnknownEmotion { name },
+        ica_core::model::BlendError::BadWeight { name, weight } => {
+            EditRefused::BadWeight { name, weight }
+        }
     })?;
     let point: Vec<f32> = point.iter().map(|&v| v as f32).collect();
     edit.set_target(name, &point)

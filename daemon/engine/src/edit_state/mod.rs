@@ -47,10 +47,22 @@ pub enum EditRefused {
     #[error("the model has no emotion component")]
     NoEmotion,
     /// The model has no level for that emotion.
-    #[error("unknown emotion {name:?}")]
+    #[error("unknown emotion {name:?} (the model knows {known})")]
     UnknownEmotion {
         /// Name received.
         name: String,
+        /// The emotions the model knows, comma separated.
+        known: String,
+    },
+    /// A blend weight that is negative or not finite, or weights that sum to zero.
+    #[error(
+        "blend weight {weight} for {name:?}: weights must be finite, at least 0, and not all 0"
+    )]
+    BadWeight {
+        /// The emotion it was given for.
+        name: String,
+        /// The weight.
+        weight: f64,
     },
     /// A target point with a number of levels other than the emotion space's dimensions.
     #[error("a target of {got} levels for an emotion space of {expected}")]

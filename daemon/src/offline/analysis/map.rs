@@ -2,8 +2,8 @@
 //! in the plane of the two strongest emotion directions, and the level table of the report.
 //!
 //! The plane is spanned by the two leading principal axes of the emotion points (centred on
-//! their mean); with a one-dimensional space the second axis is empty and the points sit on a
-//! line.
+//! their mean); a one-dimensional space is drawn as a line across a lower box, titled with
+//! its one direction.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -14,6 +14,8 @@ use super::Report;
 
 const W: f64 = 520.0;
 const H: f64 = 420.0;
+/// Height of a one-direction map (a line, no plane).
+const H_LINE: f64 = 160.0;
 const MARGIN: f64 = 50.0;
 /// Colours of the emotions, in name order, cycling.
 const PALETTE: [&str; 8] = [
@@ -78,6 +80,34 @@ fn take_points(
         .collect()
 }
 
+/// The map's box and title, with the axis across it for a line.
+fn map_frame(line: bool, h: f64, components: &[usize]) -> String {
+    let mut svg = format!(
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{h}" font-family="sans-serif"><rect width="100%" height="100%" fill="#fff"/><text x="{MARGIN}" y="24" font-size="14" font-weight="bold">{}</text>"##,
+        map_title(line, components)
+    );
+    if line {
+        let _ = write!(
+            svg,
+            r##"<line class="axis" x1="{MARGIN}" y1="{y}" x2="{}" y2="{y}" stroke="#888"/>"##,
+            W - MARGIN,
+            y = h / 2.0
+        );
+    }
+    svg
+}
+
+/// The map's title: the plane of the first two directions, or the one direction's line.
+fn map_title(line: bool, components: &[usize]) -> String {
+    match (line, components) {
+        (true, [k]) => {
+            format!("Emotion map: takes and emotion levels along the one emotion direction, c{k}")
+        }
+        (true, _) => "Emotion map: takes and emotion levels along the one emotion direction".into(),
+        (false, _) => "Emotion map: takes and emotion levels, first two emotion directions".into(),
+    }
+}
+
 /// The map, or `None` when the analysis found no emotion space.
 pub fn emotion_map(report: &Report) -> Option<String> {
     let space = report.space.as_ref()?;
@@ -100,12 +130,16 @@ pub fn emotion_map(report: &Report) -> Option<String> {
         (lo, (hi - lo).max(1e-9))
     };
     let ((x0, xs), (y0, ys)) = (span(|p| p.0), span(|p| p.1));
+    // One direction: a line across the middle of a lower box, not an empty plane.
+    let line = levels.first().map_or(0, Vec::len) < 2;
+    let h = if line { H_LINE } else { H };
     let scale = ((W - 2.0 * MARGIN) / xs).min((H - 2.0 * MARGIN) / ys.max(xs * 0.05));
     let px = |x: f64| MARGIN + (x - x0) * scale;
-    let py = |y: f64| H - MARGIN - (y - y0) * scale;
-    let mut svg = format!(
-        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" font-family="sans-serif"><rect width="100%" height="100%" fill="#fff"/><text x="{MARGIN}" y="24" font-size="14" font-weight="bold">Emotion map: takes and emotion levels, first two emotion directions</text>"##
-    );
+    let py = |y: f64| match line {
+        true => h / 2.0,
+        false => H - MARGIN - (y - y0) * scale,
+    };
+    let mut svg = map_frame(line, h, &space.components);
     for (e, (x, y)) in &takes {
         let _ = write!(
             svg,
