@@ -59,13 +59,13 @@ pub(crate) enum Refusal {
     #[error("{0}")]
     Model(String),
     /// The peer is not in `control_allow`.
-    #[error("control from {0} is not allowed (control_allow)")]
+    #[error("control from {0} is not allowed: add its network to control_allow (--control-allow) on the daemon")]
     NotAllowed(std::net::IpAddr),
     /// A mutating control without the shared secret.
-    #[error("this control needs the shared secret as its last argument")]
+    #[error("this control needs the shared secret as its last argument: append control_secret as a string")]
     Secret,
     /// The processing thread did not take the command (queue full or stopped).
-    #[error("the processing thread is busy or stopped")]
+    #[error("the processing thread is busy or stopped: try again in a moment")]
     Busy,
     /// The processing thread did not answer in time.
     #[error("no answer from the processing thread")]

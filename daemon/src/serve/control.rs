@@ -265,7 +265,7 @@ pub(crate) async fn reload_on_sighup(ctx: ControlCtx, shutdown: CancellationToke
                     let Some(path) = path else { continue };
                     match reload(&ctx, path).await {
                         Ok(()) => {}
-                        Err(e) => tracing::warn!(target: "emoshift", error = %e, "SIGHUP reload failed, old model kept"),
+                        Err(e) => tracing::warn!(target: "emoshift", error = %e, "SIGHUP reload failed, old model kept: fix the model file and send SIGHUP again, or /model/load another"),
                     }
                 }
             }

@@ -28,7 +28,7 @@ pub fn bind_receiver(addr: SocketAddr) -> std::io::Result<tokio::net::UdpSocket>
 pub fn bind_receiver_std(addr: SocketAddr) -> std::io::Result<std::net::UdpSocket> {
     let s = Socket::new(Domain::for_address(addr), Type::DGRAM, Some(Protocol::UDP))?;
     if let Err(e) = s.set_recv_buffer_size(RECV_BUFFER_BYTES) {
-        tracing::warn!(target: "emoshift", %addr, error = %e, "cannot enlarge the receive buffer");
+        tracing::warn!(target: "emoshift", %addr, error = %e, "cannot enlarge the receive buffer: bursts may be dropped; raise the limit (sysctl net.core.rmem_max)");
     }
     // Linux reports twice the usable size it granted.
     let granted = s.recv_buffer_size().unwrap_or(0) / 2;

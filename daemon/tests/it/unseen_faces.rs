@@ -329,7 +329,18 @@ fn issue12_too_many_components_on_a_small_session_warn_of_noise_and_instability(
         .lines()
         .find(|l| l.contains("not found again"))
         .expect("the warning");
-    let listed = unstable.split("below 0.9): ").nth(1).expect("a list");
+    let (listed, advice) = unstable
+        .split("below 0.9): ")
+        .nth(1)
+        .and_then(|l| l.split_once("; "))
+        .expect("a list, then what to try");
+    // Issue 37: what to try, with numbers.
+    assert!(
+        advice.contains("fewer components (--components ")
+            && advice.contains("more frames")
+            && advice.contains("more restarts (--restarts "),
+        "{unstable}"
+    );
     for item in listed.split(", ") {
         let (name, value) = item.split_once(" (").expect("c<k> (<corr>)");
         assert!(

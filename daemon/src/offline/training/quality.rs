@@ -81,7 +81,7 @@ pub fn assess_measured(
             q.warn(
                 WarningKind::SlowResidual,
                 format!(
-                    "the model leaves out a slow signal of {mm:.2} mm RMS (peak at {marker}): {} components cannot hold it; raise --components or --variance",
+                    "the model leaves out a slow signal of {mm:.2} mm RMS (peak at {marker}): {} components cannot hold it; raise --components or --variance, or check {marker} for a slow drift (a loose marker) with emoshift info",
                     model.components()
                 ),
             );
@@ -132,7 +132,7 @@ fn warn_head(q: &mut ModelQuality) {
         q.warn(
             WarningKind::HeadReference,
             format!(
-                "the head reference named by --head-reference ({}) is not used, and frames are not stabilised: {why}",
+                "the head reference named by --head-reference ({}) is not used, and frames are not stabilised: {why}; name markers that move with the head only (forehead, temples, a headband), or train without one (--head-reference none)",
                 h.markers.join(", ")
             ),
         );
@@ -141,7 +141,7 @@ fn warn_head(q: &mut ModelQuality) {
         q.warn(
             WarningKind::HeadReference,
             format!(
-                "the head reference ({}) deforms by {:.2} mm RMS, beyond the capture's noise ({:.3} mm): expect about {:.2} mm of pose error on every marker",
+                "the head reference ({}) deforms by {:.2} mm RMS, beyond the capture's noise ({:.3} mm): expect about {:.2} mm of pose error on every marker; name stiffer markers with --head-reference (forehead, temples, a headband), or train without one (--head-reference none)",
                 h.markers.join(", "),
                 h.deformation_mm.unwrap_or(f64::NAN),
                 h.noise_mm.unwrap_or(f64::NAN),
@@ -153,7 +153,7 @@ fn warn_head(q: &mut ModelQuality) {
         q.warn(
             WarningKind::HeadReference,
             format!(
-                "the head reference ({}) moves with the face: its pose explains {:.0} % of the other markers' motion",
+                "the head reference ({}) moves with the face: its pose explains {:.0} % of the other markers' motion; name markers away from the brows, eyes and mouth with --head-reference, or train without one (--head-reference none)",
                 h.markers.join(", "),
                 100.0 * h.leakage.unwrap_or(0.0)
             ),
@@ -168,7 +168,7 @@ fn warn_frames(q: &mut ModelQuality, model: &IcaModel) {
         q.warn(
             WarningKind::FewFrames,
             format!(
-                "trained on {} frames for {} channels and {} components: the covariance needs at least {needed} frames ({FRAMES_PER_CHANNEL} per channel); the model fits these frames, not the face",
+                "trained on {} frames for {} channels and {} components: the covariance needs at least {needed} frames ({FRAMES_PER_CHANNEL} per channel); the model fits these frames, not the face; record more takes or longer ones, or leave markers out",
                 r.frames_used, r.channels, r.components
             ),
         );
@@ -180,7 +180,7 @@ fn warn_components(q: &mut ModelQuality, model: &IcaModel) {
         q.warn(
             WarningKind::OneMarkerComponent,
             format!(
-                "component {i} is carried by marker {} alone ({:.0} % of its motion): a likely label swap or glitch",
+                "component {i} is carried by marker {} alone ({:.0} % of its motion): a likely label swap or glitch; look at that marker with emoshift info and fix the takes with emoshift repair, or leave it out of the takes",
                 model.labels()[marker],
                 100.0 * share
             ),
@@ -198,8 +198,10 @@ fn warn_components(q: &mut ModelQuality, model: &IcaModel) {
         q.warn(
             WarningKind::UnstableComponent,
             format!(
-                "components not found again by the other restarts (best-match |corr| below {UNSTABLE_BELOW}): {}",
-                unstable.join(", ")
+                "components not found again by the other restarts (best-match |corr| below {UNSTABLE_BELOW}): {}; try fewer components (--components {}), more frames (more or longer takes), or more restarts (--restarts {})",
+                unstable.join(", "),
+                model.components().saturating_sub(unstable.len()).max(1),
+                2 * model.report().restarts.len().max(1)
             ),
         );
     }

@@ -73,7 +73,7 @@ pub(crate) async fn serve(listener: TcpListener, m: Arc<Monitor>) {
         .with_graceful_shutdown(async move { shutdown.cancelled().await })
         .await;
     if let Err(e) = served {
-        tracing::warn!(target: "emoshift", error = %e, "monitor page stopped");
+        tracing::warn!(target: "emoshift", error = %e, "monitor page stopped: the daemon runs on; restart serve to get the page back");
     }
 }
 

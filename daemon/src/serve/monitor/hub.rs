@@ -134,7 +134,7 @@ impl Hub {
         viewers.retain(|v| match v.texts.try_send(message.clone()) {
             Ok(()) => true,
             Err(_) => {
-                tracing::warn!(target: "emoshift", "monitor page too slow, disconnected");
+                tracing::warn!(target: "emoshift", "monitor page too slow, disconnected: reload the page; on a slow network open it nearer the daemon");
                 false
             }
         });

@@ -242,7 +242,7 @@ impl Sink for OscOutput {
                 SendOutcome::Dropped => {
                     sockets.remove(&addr);
                     counters.clients_dropped += 1;
-                    tracing::warn!(target: "emoshift", %addr, "subscriber dropped after repeated send failures");
+                    tracing::warn!(target: "emoshift", %addr, "subscriber dropped after repeated send failures: its port refuses frames; it may /subscribe again once it listens");
                     continue;
                 }
                 SendOutcome::BackingOff(wait) => {

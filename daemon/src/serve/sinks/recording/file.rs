@@ -70,7 +70,7 @@ impl File {
                 Err(e) => return self.fail(&e),
             }
         } else if lost > MAX_FILL {
-            tracing::warn!(target: "emoshift", path = %self.path.display(), lost, "long pause not filled");
+            tracing::warn!(target: "emoshift", path = %self.path.display(), lost, "long pause not filled: the take jumps over it; if the source paused, start a new recording after a pause");
         } else {
             for _ in 0..lost {
                 if let Some(Err(e)) = self
@@ -92,7 +92,7 @@ impl File {
     }
 
     fn fail(&mut self, e: &replay::WriteError) {
-        tracing::warn!(target: "emoshift", path = %self.path.display(), error = %e, "recording stopped");
+        tracing::warn!(target: "emoshift", path = %self.path.display(), error = %e, "recording stopped: the file holds the frames before it; free space or record to another disk, then /record/start again");
         self.error = Some(e.to_string());
     }
 

@@ -106,7 +106,7 @@ impl Recorder {
     pub fn finish(mut self) {
         if let Some(rec) = self.running.take() {
             if let Err(e) = rec.finish() {
-                tracing::warn!(target: "emoshift", error = %e, "recording failed");
+                tracing::warn!(target: "emoshift", error = %e, "recording failed: check the path and the free space, then /record/start again");
             }
         }
         for closing in self.closing.drain(..) {
@@ -171,7 +171,7 @@ fn close_in_background(rec: Recording, reply: Option<oneshot::Sender<Reply>>) ->
             .map(|_| ())
             .map_err(|e| Refusal::from_error(Refusal::Record, &e));
         if let Err(e) = &r {
-            tracing::warn!(target: "emoshift", error = %e, "recording failed");
+            tracing::warn!(target: "emoshift", error = %e, "recording failed: check the path and the free space, then /record/start again");
         }
         if let Some(reply) = reply {
             let _ = reply.send(r);

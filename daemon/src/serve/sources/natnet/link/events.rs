@@ -42,7 +42,7 @@ impl Link {
                     self.status.connected = false;
                     self.status.disconnects += 1;
                     tracing::warn!(target: "emoshift", server = %self.config.server, ?reason,
-                        "natnet: server lost, reconnecting");
+                        "natnet: server lost, reconnecting; if it stays lost, check that Motive runs and streams (Settings > Streaming)");
                 }
                 Event::ClockOffset(est) => {
                     self.status.clock_offset_us = Some((est.offset_s * 1e6) as i64);
