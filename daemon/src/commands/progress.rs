@@ -15,7 +15,7 @@ use crate::offline::progress::Progress;
 pub const LINE_INTERVAL: Duration = Duration::from_secs(5);
 
 /// The progress display of a command: a bar on a terminal, lines otherwise.
-pub fn for_stderr(command: &'static str) -> Box<dyn Progress> {
+pub fn for_stderr(command: &'static str) -> Box<dyn Progress + Send> {
     if std::io::stderr().is_terminal() {
         return Box::new(Bar::new(command));
     }

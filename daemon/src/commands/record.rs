@@ -6,7 +6,8 @@ use tokio_util::sync::CancellationToken;
 
 use crate::cli::RecordArgs;
 use crate::exit::UsageError;
-use crate::serve::capture::{self, CaptureConfig, Source};
+use crate::offline::progress::Progress;
+use crate::serve::capture::{self, CaptureConfig, Notice, Source};
 
 /// The arguments, checked.
 fn config(args: &RecordArgs) -> Result<CaptureConfig> {
@@ -42,6 +43,45 @@ fn config(args: &RecordArgs) -> Result<CaptureConfig> {
     })
 }
 
+/// The capture's progress as `train` shows its own: a bar on a terminal (frames, rate, gaps,
+/// time), a line every few seconds in a pipe; notices as lines.
+struct Shown {
+    progress: Box<dyn Progress + Send>,
+    /// Stop after this many frames (the bar's total).
+    total: Option<u64>,
+    /// Frames shown so far (`None` before the first).
+    frames: Option<u64>,
+}
+
+impl Shown {
+    fn new(total: Option<u64>) -> Shown {
+        Shown {
+            progress: super::progress::for_stderr("record"),
+            total,
+            frames: None,
+        }
+    }
+
+    fn notice(&mut self, notice: Notice<'_>) {
+        let p = match notice {
+            Notice::Line(line) => return eprintln!("emoshift record: {line}"),
+            Notice::Progress(p) => p,
+        };
+        let before = *self.frames.get_or_insert_with(|| {
+            let name = format!("recording {}", p.stream);
+            self.progress.step(&name, "frames", self.total);
+            0
+        });
+        self.progress.advance(p.frames.saturating_sub(before));
+        self.frames = Some(p.frames.max(before));
+        let rate = p
+            .rate_hz
+            .map_or("rate not measured yet".into(), |r| format!("{r:.2} Hz"));
+        self.progress
+            .note(&format!("{rate}, {} gaps, {:.1} s", p.gaps, p.seconds));
+    }
+}
+
 pub(crate) fn run(args: &RecordArgs) -> Result<()> {
     let config = config(args)?;
     let out = config.out.clone();
@@ -53,8 +93,10 @@ pub(crate) fn run(args: &RecordArgs) -> Result<()> {
         .block_on(async move {
             let shutdown = CancellationToken::new();
             tokio::spawn(super::serve::cancel_on_signal(shutdown.clone()));
-            let mut notice = |line: &str| eprintln!("emoshift record: {line}");
-            capture::run(config, shutdown, &mut notice).await
+            let mut shown = Shown::new(config.frames);
+            let mut notice = |n: Notice<'_>| shown.notice(n);
+            let done = capture::run(config, shutdown, &mut notice).await;
+            super::progress::settle(shown.progress.as_mut(), done)
         })
         .map_err(|e| {
             // A full disk: the file is closed valid with the frames that fit; say what to do.

@@ -1,13 +1,13 @@
 //! Issue 37, the first hour on a stage: a NatNet name mismatch in `serve` warns, naming both
 //! sides and the flag that fixes it; a wrong `--performer` in `record` says which marker sets
-//! the server has, and exits non-zero when nothing was written.
+//! the server has, and exits non-zero when nothing was written; `record` shows its progress.
 
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::natnet::{motive, stream};
+use super::natnet::{motive, send_osc, stream};
 use super::support::*;
 
 /// Lines of `child`'s stderr, each with when it came, gathered on a thread.
@@ -124,4 +124,36 @@ async fn a_wrong_performer_is_named_at_once_and_exits_non_zero() {
     assert!(told < Duration::from_secs(2), "told after {told:?}");
     assert!(!done.success(), "exit status {done:?}:\n{err}");
     assert!(!out.exists(), "nothing is written");
+}
+
+/// `record` shows how the take goes while it records (frames, rate, gaps, time), as `train`
+/// shows its steps: here in a pipe, with a line for every advance.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn record_shows_frames_rate_gaps_and_time_while_it_records() {
+    let m = model_file(39);
+    let port = free_port();
+    let out = m.dir.path().join("take.csv");
+    let child = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"))
+        .args(["record", "--listen", &format!("127.0.0.1:{port}")])
+        .args(["--frames", "100", "--out"])
+        .arg(&out)
+        .env("EMOSHIFT_PROGRESS_SECS", "0")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary starts");
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    let to = format!("127.0.0.1:{port}").parse().expect("addr");
+    send_osc(&m, to, 0..110).await;
+    let done = tokio::task::spawn_blocking(move || child.wait_with_output())
+        .await
+        .expect("join")
+        .expect("the child ends by itself after 100 frames");
+    let err = String::from_utf8_lossy(&done.stderr);
+    assert!(done.status.success(), "{err}");
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("record: recording ") && l.contains(" Hz, 0 gaps, "))
+        .unwrap_or_else(|| panic!("no progress line with rate, gaps and time in:\n{err}"));
+    assert!(line.contains("frames"), "{line}");
 }

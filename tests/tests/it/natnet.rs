@@ -195,7 +195,7 @@ async fn daemon_osc(m: &ModelFile) -> loopback::Daemon {
 
 /// The same frames over OSC, in millimetres as the daemon computes them from metres, each in
 /// a bundle with its `/mocap/timecode`.
-async fn send_osc(m: &ModelFile, to: SocketAddr, range: std::ops::Range<usize>) {
+pub(super) async fn send_osc(m: &ModelFile, to: SocketAddr, range: std::ops::Range<usize>) {
     let labels = protocol::Labels {
         layout_id: 0,
         names: m.model.labels().to_vec(),

@@ -26,6 +26,34 @@ use take::{Captured, Incoming, Take};
 /// Silence after which `record` says nothing is arriving.
 pub const QUIET: Duration = Duration::from_secs(3);
 
+/// What the capture tells its caller: a line to print, or how far it is (on every status
+/// tick, a few times a second, once a stream is being recorded).
+#[derive(Debug)]
+pub enum Notice<'a> {
+    /// A line for the user (nothing arriving, a performer not found).
+    Line(&'a str),
+    /// The take so far.
+    Progress(&'a CaptureProgress),
+}
+
+/// The take so far, for a progress display.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaptureProgress {
+    /// The stream recorded.
+    pub stream: String,
+    /// Frames taken, gaps included.
+    pub frames: u64,
+    /// Frames written as gaps.
+    pub gaps: u64,
+    /// Seconds of capture.
+    pub seconds: f64,
+    /// The rate measured so far, Hz.
+    pub rate_hz: Option<f64>,
+}
+
+/// The callback that hears [`Notice`]s.
+pub type OnNotice<'a> = dyn FnMut(Notice<'_>) + Send + 'a;
+
 /// Where frames come from.
 #[derive(Debug, Clone)]
 pub enum Source {
@@ -78,6 +106,27 @@ impl State {
         }
     }
 
+    /// The take so far, once a stream is being recorded.
+    fn progress(&self) -> Option<CaptureProgress> {
+        Some(CaptureProgress {
+            stream: self.take.stream()?.to_string(),
+            frames: self.take.frames(),
+            gaps: self.take.gaps(),
+            seconds: self.take.seconds(),
+            rate_hz: self.take.measured(),
+        })
+    }
+
+    /// What to tell on a status tick: the quiet or wrong-performer line, then the progress.
+    fn tick(&mut self, since: Instant, what: impl FnOnce() -> String, notice: &mut OnNotice<'_>) {
+        if let Some(line) = self.quiet_notice(since, what) {
+            notice(Notice::Line(&line));
+        }
+        if let Some(p) = self.progress() {
+            notice(Notice::Progress(&p));
+        }
+    }
+
     /// A notice when nothing came for [`QUIET`] (once per quiet spell), or when the stream
     /// asked for is not among those that came (once).
     fn quiet_notice(&mut self, since: Instant, what: impl FnOnce() -> String) -> Option<String> {
@@ -96,15 +145,15 @@ impl State {
     }
 }
 
-/// Captures until done or `shutdown`; `notice` hears the quiet lines. `None` when no frame of
-/// the stream arrived (no file is left).
+/// Captures until done or `shutdown`; `notice` hears the quiet lines and the progress. `None`
+/// when no frame of the stream arrived (no file is left).
 ///
 /// # Errors
 /// A socket that cannot be bound, or a file that cannot be written.
 pub async fn run(
     config: CaptureConfig,
     shutdown: CancellationToken,
-    notice: &mut (dyn FnMut(&str) + Send),
+    notice: &mut OnNotice<'_>,
 ) -> Result<Option<Captured>> {
     let state = Mutex::new(State {
         take: Take::new(&config.out, config.performer.clone()),
@@ -168,7 +217,7 @@ async fn osc(
     state: &Mutex<State>,
     stop: &CancellationToken,
     sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
-    notice: &mut (dyn FnMut(&str) + Send),
+    notice: &mut OnNotice<'_>,
 ) -> Result<()> {
     let socket = super::net::bind_receiver(addr)
         .with_context(|| format!("binding the frame socket {addr}"))?;
@@ -190,16 +239,14 @@ async fn osc(
                 () = stop.cancelled() => return,
                 _ = tick.tick() => {}
             }
-            let line = lock(state).quiet_notice(started, || {
+            let quiet = || {
                 format!(
                     "nothing has arrived on {bound} for {} s: is the source sending \
                      /mocap/labels and /mocap/frame here?",
                     QUIET.as_secs()
                 )
-            });
-            if let Some(line) = line {
-                notice(&line);
-            }
+            };
+            lock(state).tick(started, quiet, notice);
         }
     };
     tokio::join!(super::sources::osc::run(source, sink, stop.clone()), quiet);
@@ -212,16 +259,13 @@ async fn natnet(
     state: &Mutex<State>,
     stop: &CancellationToken,
     sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
-    notice: &mut (dyn FnMut(&str) + Send),
+    notice: &mut OnNotice<'_>,
 ) -> Result<()> {
     let server = n.server;
     let link = Link::open(n, Arc::new(InputCounters::named("natnet")))?;
     let started = Instant::now();
     let mut on_status = |st: &NatNetStatus| {
-        let line = lock(state).quiet_notice(started, || natnet_quiet(server, st));
-        if let Some(line) = line {
-            notice(&line);
-        }
+        lock(state).tick(started, || natnet_quiet(server, st), notice);
     };
     link.run(stop.clone(), sink, &mut on_status).await
 }

@@ -114,6 +114,11 @@ impl Take {
         self.frames
     }
 
+    /// Frames written as gaps so far.
+    pub fn gaps(&self) -> u64 {
+        self.gaps
+    }
+
     /// The stream being recorded, once one was chosen.
     pub fn stream(&self) -> Option<&str> {
         self.stream.as_ref().map(|s| s.0.as_str())
