@@ -151,6 +151,19 @@ impl Take {
         self.missing.extend_from_slice(missing);
     }
 
+    /// Keeps frame indices `range` (0-based, clamped to the take) and drops the rest; the
+    /// first frame number moves with the cut, so the kept frames keep their numbers.
+    pub fn keep_frames(&mut self, range: std::ops::Range<usize>) {
+        let n = self.n_markers();
+        let end = range.end.min(self.n_frames());
+        let start = range.start.min(end);
+        self.positions.truncate(end * n * 3);
+        self.positions.drain(..start * n * 3);
+        self.missing.truncate(end * n);
+        self.missing.drain(..start * n);
+        self.first_frame += start as i64;
+    }
+
     /// Time in seconds of frame index `frame` (0-based), counted from the first frame.
     pub fn time_of(&self, frame: usize) -> f64 {
         frame as f64 / self.rate_hz

@@ -137,6 +137,13 @@ pub struct ConvertArgs {
     pub input: PathBuf,
     /// Output take; its extension picks the format.
     pub output: PathBuf,
+    /// First frame kept: a frame number as the file numbers it (240) or seconds from the
+    /// take's start (2.5s) [default: the first].
+    #[arg(long, value_name = "FRAME|SECONDSs")]
+    pub start: Option<crate::offline::trim::FrameOrTime>,
+    /// Last frame kept, inclusive, likewise [default: the last].
+    #[arg(long, value_name = "FRAME|SECONDSs")]
+    pub end: Option<crate::offline::trim::FrameOrTime>,
     /// Overwrite the output if it exists.
     #[arg(long)]
     pub force: bool,

@@ -1,4 +1,5 @@
-//! `emoshift convert IN OUT`: read any supported format, write any other; gaps are kept.
+//! `emoshift convert IN OUT [--start F|Ts] [--end F|Ts]`: read any supported format, write any
+//! other, optionally only a frame or time range; gaps are kept.
 
 use anyhow::{Context, Result};
 
@@ -7,7 +8,12 @@ use crate::cli::ConvertArgs;
 pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
     crate::offline::output::check_out(&args.output, &[&args.input], args.force)?;
     let cut_off = crate::offline::takes::cut_off(&args.input);
-    let take = crate::offline::load_take(&args.input)?;
+    let mut take = crate::offline::load_take(&args.input)?;
+    if args.start.is_some() || args.end.is_some() {
+        let range = crate::offline::trim::frame_range(&take, args.start, args.end)
+            .with_context(|| format!("{}", args.input.display()))?;
+        take.keep_frames(range);
+    }
     if let Some(note) = cut_off {
         crate::out!("warning: {} {note}", args.input.display());
     }

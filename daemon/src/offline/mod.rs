@@ -13,6 +13,7 @@ pub mod progress;
 pub mod streamed;
 pub mod takes;
 pub mod training;
+pub mod trim;
 
 pub use takes::{
     input_paths, load_inputs, load_model, load_model_limited, load_session, load_take,

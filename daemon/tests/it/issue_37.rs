@@ -77,3 +77,42 @@ fn serve_takes_the_allow_lists_as_flags() {
         );
     }
 }
+
+/// `convert --start/--end` keeps a frame or time range (the rest before and after a
+/// sentence), its frames keeping their numbers.
+#[test]
+fn convert_keeps_a_frame_or_time_range() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../replay/tests/fixtures/NoseMoCap_first60.trc");
+    let whole = replay::load(&input).expect("the fixture loads");
+    let first = whole.first_frame;
+    let by_frame = dir.path().join("frames.csv");
+    let (start, end) = ((first + 10).to_string(), (first + 29).to_string());
+    ok(&[
+        "convert",
+        p(&input),
+        p(&by_frame),
+        "--start",
+        &start,
+        "--end",
+        &end,
+    ]);
+    let cut = replay::load(&by_frame).expect("written");
+    assert_eq!((cut.n_frames(), cut.first_frame), (20, first + 10));
+    assert_eq!(cut.frame(0), whole.frame(10));
+    let by_time = dir.path().join("time.csv");
+    let secs = format!("{}s", 10.0 / whole.rate_hz);
+    ok(&["convert", p(&input), p(&by_time), "--start", &secs]);
+    let cut = replay::load(&by_time).expect("written");
+    assert_eq!(cut.n_frames(), whole.n_frames() - 10);
+    let out = crate::common::run(&[
+        "convert",
+        p(&input),
+        p(&by_time),
+        "--start",
+        "1000000",
+        "--force",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "an empty range is refused");
+}
