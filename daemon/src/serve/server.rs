@@ -280,6 +280,7 @@ fn outputs(
         max_send_failures: config.max_send_failures,
         lease: config.lease,
         max_markers: PipelineConfig::default().max_markers,
+        vmc_names: config.vmc_names.clone(),
     })?;
     let mut others: Vec<Box<dyn engine::Sink + Send>> = Vec::new();
     if let Some(natnet) = natnet {

@@ -114,6 +114,9 @@ pub struct RawConfig {
     pub natnet_server_raw: Option<bool>,
     /// Unicast NatNet clients at most.
     pub natnet_server_max_clients: Option<usize>,
+    /// The components profile's blend names (`emotion`, `speech1`, ...) to the names receivers
+    /// want (an avatar's blendshapes).
+    pub vmc_names: HashMap<String, String>,
     /// The monitor page's address (off when absent).
     pub monitor: Option<String>,
     /// The monitor page's token (generated and printed when the page is bound beyond
@@ -160,6 +163,8 @@ pub struct Config {
     pub natnet: Option<super::sources::natnet::NatNetConfig>,
     /// The NatNet server, if any.
     pub natnet_server: Option<super::sinks::natnet::NatNetServerConfig>,
+    /// The components profile's blend names to the names sent instead.
+    pub vmc_names: HashMap<String, String>,
     /// The monitor page's address, if it is served.
     pub monitor: Option<SocketAddr>,
     /// The monitor page's token, if one is set.
@@ -242,6 +247,7 @@ impl RawConfig {
                 .collect::<Result<_, _>>()?,
             natnet,
             natnet_server,
+            vmc_names: self.vmc_names,
             monitor: self
                 .monitor
                 .map(|m| addr("monitor", Some(m), ""))

@@ -62,6 +62,8 @@ pub struct OscOutputConfig {
     pub lease: Duration,
     /// Largest frame, markers.
     pub max_markers: usize,
+    /// Blend names sent instead of the defaults (`vmc_names`).
+    pub vmc_names: HashMap<String, String>,
 }
 
 /// The subscribers, their sockets and the encoded frame, owned by the processing thread.
@@ -100,7 +102,7 @@ impl OscOutput {
             subscribers,
             sockets,
             encoder: Encoder::new(config.max_markers),
-            names: Names::default(),
+            names: Names::renamed(config.vmc_names.clone()),
             counters: SendCounters::default(),
             sent_us: latency::histogram(),
             next_expiry: Instant::now() + EXPIRY_EVERY,

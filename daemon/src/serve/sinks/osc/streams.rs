@@ -2,6 +2,7 @@
 //! order, layout id = stream id) and the VMC blend names of its labelled components, made
 //! once per stream and model (a model swap makes them again).
 
+use std::collections::HashMap;
 use std::sync::Arc;
 
 use engine::pipeline::MAX_SOURCES;
@@ -27,9 +28,19 @@ pub struct Names {
     /// When each was last used (a count of frames), to evict the longest unused.
     used: Vec<u64>,
     frames: u64,
+    /// Blend names sent instead of the defaults (`vmc_names`).
+    rename: HashMap<String, String>,
 }
 
 impl Names {
+    /// Names whose default blend names `rename` maps to others.
+    pub fn renamed(rename: HashMap<String, String>) -> Names {
+        Names {
+            rename,
+            ..Names::default()
+        }
+    }
+
     /// The names of `frame`'s stream, made on its first frame or after a model swap.
     pub fn of(&mut self, frame: &Processed<'_>) -> &StreamNames {
         self.frames += 1;
@@ -37,11 +48,11 @@ impl Names {
         let at = match self.streams.iter().position(|s| s.id == id) {
             Some(i) if Arc::ptr_eq(&self.streams[i].model, model) => i,
             Some(i) => {
-                self.streams[i] = StreamNames::new(id, model);
+                self.streams[i] = StreamNames::new(id, model, &self.rename);
                 i
             }
             None if self.streams.len() < MAX_SOURCES => {
-                self.streams.push(StreamNames::new(id, model));
+                self.streams.push(StreamNames::new(id, model, &self.rename));
                 self.used.push(0);
                 self.streams.len() - 1
             }
@@ -49,7 +60,7 @@ impl Names {
                 let oldest = (0..self.used.len())
                     .min_by_key(|&i| self.used[i])
                     .unwrap_or(0);
-                self.streams[oldest] = StreamNames::new(id, model);
+                self.streams[oldest] = StreamNames::new(id, model, &self.rename);
                 oldest
             }
         };
@@ -59,7 +70,7 @@ impl Names {
 }
 
 impl StreamNames {
-    fn new(id: i32, model: &Arc<IcaModel>) -> StreamNames {
+    fn new(id: i32, model: &Arc<IcaModel>, rename: &HashMap<String, String>) -> StreamNames {
         let labels = Labels {
             layout_id: id,
             names: model.labels().to_vec(),
@@ -72,7 +83,10 @@ impl StreamNames {
             id,
             model: Arc::clone(model),
             labels_msg,
-            vmc: vmc_names(model),
+            vmc: vmc_names(model)
+                .into_iter()
+                .map(|(name, k)| (rename.get(&name).cloned().unwrap_or(name), k))
+                .collect(),
         }
     }
 }
