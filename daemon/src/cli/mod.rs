@@ -83,6 +83,12 @@ pub enum Command {
         `emoshift info` says when a take needs it (\"holds 363 frames, header says 1\")."
     )]
     Repair(RepairArgs),
+    /// Propose a regions.toml (mouth, eyebrows, eyelids, head reference) from a take's marker
+    /// names and geometry, a comment on each line saying why; check it, then analyze.
+    #[command(
+        after_help = "Example:\n  emoshift regions session/s01_neutral.c3d --out session/regions.toml"
+    )]
+    Regions(RegionsArgs),
     /// Convert a take between C3D, TRC and CSV (format chosen by extension; gaps kept).
     #[command(after_help = "Examples:\n  emoshift convert Facial-Sing.c3d x.trc\n  \
         emoshift convert x.trc y.c3d")]
@@ -155,6 +161,19 @@ pub struct RepairArgs {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Overwrite --out if it exists.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `emoshift regions`.
+#[derive(Debug, clap::Args)]
+pub struct RegionsArgs {
+    /// A take of the performer (.c3d, .trc or .csv).
+    pub take: PathBuf,
+    /// Where to write the proposal.
+    #[arg(long, default_value = "regions.toml")]
+    pub out: PathBuf,
+    /// Overwrite the output if it exists.
     #[arg(long)]
     pub force: bool,
 }

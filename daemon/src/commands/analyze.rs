@@ -81,7 +81,13 @@ pub(crate) fn analyze_and_write(
         Some(p) => p.to_path_buf(),
         None => session.base_dir.join("regions.toml"),
     };
-    let regions = analysis::resolve_regions(&regions_path, &model)?;
+    let regions = analysis::resolve_regions(&regions_path, &model).with_context(|| {
+        format!(
+            "analyze needs a regions file naming the mouth, eyebrows and eyelids markers; \
+             propose one with `emoshift regions TAKE --out {}`, check it, and run again",
+            regions_path.display()
+        )
+    })?;
     let inputs = Inputs {
         model: &model,
         model_path,

@@ -11,6 +11,7 @@ mod inspect;
 pub mod progress;
 mod project;
 mod record;
+mod regions;
 mod repair;
 mod replay;
 mod serve;
@@ -61,6 +62,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Inject(args) => inject::run(&args),
         Command::Repair(args) => repair::run(&args),
         Command::Convert(args) => convert::run(&args),
+        Command::Regions(args) => regions::run(&args),
         Command::Train(args) => train::run(&args),
         Command::Project(args) => project::run(&args),
         Command::Edit(args) => edit::run(&args),

@@ -10,6 +10,7 @@ pub mod edit;
 pub mod inject;
 pub mod output;
 pub mod progress;
+pub mod regions;
 pub mod streamed;
 pub mod takes;
 pub mod training;

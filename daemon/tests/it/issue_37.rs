@@ -116,3 +116,67 @@ fn convert_keeps_a_frame_or_time_range() {
     ]);
     assert_eq!(out.status.code(), Some(1), "an empty range is refused");
 }
+
+/// `analyze` without a regions file points to `emoshift regions`, whose proposal lets the
+/// analysis run (Motive's `Face:` prefix: the module's unit test).
+#[test]
+fn regions_proposes_a_file_that_analyze_takes() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let session = dir.path().join("s");
+    ok(&[
+        "synth",
+        "--out",
+        p(&session),
+        "--seed",
+        "4",
+        "--sentences",
+        "2",
+    ]);
+    std::fs::remove_file(session.join("regions.toml")).expect("synth wrote one");
+    let manifest = session.join("session.toml");
+    let model = dir.path().join("model.json");
+    ok(&["train", "--manifest", p(&manifest), "--out", p(&model)]);
+    let analyze = |extra: &[&str]| {
+        let report = dir.path().join("report");
+        let mut args = vec![
+            "analyze",
+            "--model",
+            p(&model),
+            "--manifest",
+            p(&manifest),
+            "--out",
+            p(&report),
+            "--force",
+        ];
+        args.extend_from_slice(extra);
+        crate::common::run(&args)
+    };
+    let out = analyze(&[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("emoshift regions TAKE --out"), "{err}");
+    let regions = dir.path().join("regions.toml");
+    let said = ok(&[
+        "regions",
+        p(&session.join("s01_neutral.c3d")),
+        "--out",
+        p(&regions),
+    ]);
+    assert!(
+        said.contains("mouth: ") && said.contains("wrote "),
+        "{said}"
+    );
+    let text = std::fs::read_to_string(&regions).expect("written");
+    assert!(
+        text.lines()
+            .filter(|l| l.trim_start().starts_with('"'))
+            .all(|l| l.contains("  # ")),
+        "a comment on every marker line:\n{text}"
+    );
+    let out = analyze(&["--regions", p(&regions)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -1,0 +1,239 @@
+//! `emoshift regions`: a first `regions.toml` proposed from a take's marker names and geometry
+//! (issue 37), so `analyze` can run on a layout nobody wrote a regions file for. Names are read
+//! without an asset prefix (Motive's `Face:`), and written in full, so the file matches the
+//! take. Every marker line carries a comment saying why it is there: a proposal to check, not a
+//! verdict.
+
+use std::fmt::Write as _;
+
+use replay::Take;
+
+/// Name fragments (lower case, asset prefix removed) that put a marker in a region, in the
+/// order regions are tried: a brow is never an eyelid, whatever else its name says.
+const BY_NAME: [(&str, &[&str]); 4] = [
+    ("eyebrows", &["brow"]),
+    ("eyelids", &["lid", "blink", "eye"]),
+    ("mouth", &["lip", "mouth", "jaw", "chin", "mth"]),
+    (
+        "head_reference",
+        &["head", "temple", "ear", "forehead", "hdr"],
+    ),
+];
+
+/// Markers the geometry gives a region when no name does: shares of the face's height.
+const MOUTH_BELOW: f64 = 0.35;
+const BROWS_ABOVE: f64 = 0.75;
+const LIDS_FROM: f64 = 0.55;
+/// Markers taken as the head reference from the geometry: the ones that move least.
+const HEAD_MARKERS: usize = 4;
+
+/// One marker proposed for a region, with why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Proposal {
+    /// The region: mouth, eyebrows, eyelids or head_reference.
+    pub region: &'static str,
+    /// The marker's label, as the take names it.
+    pub label: String,
+    /// Why.
+    pub why: String,
+}
+
+/// A marker's name without its asset prefix (`Face:BrowL` -> `BrowL`).
+fn bare(label: &str) -> &str {
+    label.rsplit_once(':').map_or(label, |(_, m)| m)
+}
+
+/// The proposals for `take`: by name first; a region no name fills, from the geometry.
+pub fn propose(take: &Take) -> Vec<Proposal> {
+    let mut out: Vec<Proposal> = Vec::new();
+    for (i, label) in take.labels.iter().enumerate() {
+        let name = bare(label).to_lowercase();
+        let hit = BY_NAME.iter().find_map(|(region, keys)| {
+            let key = keys.iter().find(|k| name.contains(*k))?;
+            Some((*region, *key))
+        });
+        if let Some((region, key)) = hit {
+            let why = format!("name contains {key:?}");
+            out.push(Proposal {
+                region,
+                label: take.labels[i].clone(),
+                why,
+            });
+        }
+    }
+    let stats = marker_stats(take);
+    for region in ["mouth", "eyebrows", "eyelids", "head_reference"] {
+        if !out.iter().any(|p| p.region == region) {
+            let taken: Vec<String> = out.iter().map(|p| p.label.clone()).collect();
+            out.extend(by_geometry(take, &stats, region, &taken));
+        }
+    }
+    out
+}
+
+/// Per marker: mean position and RMS motion about it (mm), over the frames where it is seen.
+fn marker_stats(take: &Take) -> Vec<Option<([f64; 3], f64)>> {
+    (0..take.n_markers())
+        .map(|m| {
+            let seen: Vec<[f32; 3]> = (0..take.n_frames())
+                .filter_map(|f| take.sample(f, m))
+                .collect();
+            if seen.is_empty() {
+                return None;
+            }
+            let n = seen.len() as f64;
+            let mean: [f64; 3] =
+                std::array::from_fn(|a| seen.iter().map(|p| f64::from(p[a])).sum::<f64>() / n);
+            let var = seen
+                .iter()
+                .map(|p| {
+                    (0..3)
+                        .map(|a| (f64::from(p[a]) - mean[a]).powi(2))
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+                / n;
+            Some((mean, var.sqrt()))
+        })
+        .collect()
+}
+
+/// A region from the geometry: height bands along the axis the markers span most (the face
+/// is taller than wide or deep), or the least-moving markers for the head reference.
+fn by_geometry(
+    take: &Take,
+    stats: &[Option<([f64; 3], f64)>],
+    region: &'static str,
+    taken: &[String],
+) -> Vec<Proposal> {
+    let seen: Vec<(usize, [f64; 3], f64)> = stats
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| s.map(|(mean, motion)| (i, mean, motion)))
+        .collect();
+    let span = |a: usize| {
+        let lo = seen.iter().map(|s| s.1[a]).fold(f64::INFINITY, f64::min);
+        let hi = seen
+            .iter()
+            .map(|s| s.1[a])
+            .fold(f64::NEG_INFINITY, f64::max);
+        (lo, (hi - lo).max(1e-9))
+    };
+    let up = (0..3)
+        .max_by(|&a, &b| span(a).1.total_cmp(&span(b).1))
+        .unwrap_or(1);
+    let (lo, height) = span(up);
+    let axis = ["x", "y", "z"][up];
+    let mut picked: Vec<(usize, String)> = Vec::new();
+    if region == "head_reference" {
+        // Not a marker another region holds: the face's own markers make a poor reference.
+        let mut still: Vec<_> = seen
+            .iter()
+            .filter(|s| !taken.contains(&take.labels[s.0]))
+            .copied()
+            .collect();
+        still.sort_by(|a, b| a.2.total_cmp(&b.2));
+        for (i, _, motion) in still.into_iter().take(HEAD_MARKERS) {
+            picked.push((i, format!("moves least over the take ({motion:.2} mm RMS)")));
+        }
+    } else {
+        for (i, mean, _) in &seen {
+            let h = (mean[up] - lo) / height;
+            let band = match region {
+                "mouth" => h < MOUTH_BELOW,
+                "eyebrows" => h > BROWS_ABOVE,
+                _ => (LIDS_FROM..=BROWS_ABOVE).contains(&h),
+            };
+            if band {
+                picked.push((
+                    *i,
+                    format!("at {:.0} % of the face's height ({axis} up)", 100.0 * h),
+                ));
+            }
+        }
+    }
+    picked
+        .into_iter()
+        .map(|(i, why)| Proposal {
+            region,
+            label: take.labels[i].clone(),
+            why: format!("geometry: {why}"),
+        })
+        .collect()
+}
+
+/// The proposals as `regions.toml`, one marker a line with its reason.
+pub fn to_toml(proposals: &[Proposal], source: &str) -> String {
+    let mut out = format!(
+        "# regions.toml proposed by `emoshift regions` from {source}: check every line before\n\
+         # `emoshift analyze` (which needs mouth, eyebrows and eyelids); head_reference names\n\
+         # markers that move with the head only, for `train`.\n"
+    );
+    for region in ["mouth", "eyebrows", "eyelids", "head_reference"] {
+        if !proposals.iter().any(|p| p.region == region) {
+            let _ = writeln!(out, "# {region}: no marker found; name its markers here");
+            continue;
+        }
+        let _ = writeln!(out, "{region} = [");
+        for p in proposals.iter().filter(|p| p.region == region) {
+            let _ = writeln!(out, "    {:?},  # {}", p.label, p.why);
+        }
+        let _ = writeln!(out, "]");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_with_motives_prefix_and_numbered_layouts_both_get_regions() {
+        let labels = [
+            "Face:BrowL",
+            "Face:UpperLip",
+            "Face:LidR",
+            "Face:HeadTop",
+            "Face:Cheek",
+        ];
+        let mut take = Take::new(labels.iter().map(|s| s.to_string()).collect(), 100.0, 1);
+        take.push_frame(&[0.0; 15], &[false; 5]);
+        let p = propose(&take);
+        let of = |r: &str| -> Vec<&str> {
+            p.iter()
+                .filter(|x| x.region == r)
+                .map(|x| x.label.as_str())
+                .collect()
+        };
+        assert_eq!(of("eyebrows"), ["Face:BrowL"]);
+        assert_eq!(of("mouth"), ["Face:UpperLip"]);
+        assert_eq!(of("eyelids"), ["Face:LidR"]);
+        assert_eq!(of("head_reference"), ["Face:HeadTop"]);
+        let text = to_toml(&p, "t.c3d");
+        let back = replay::session::Regions::parse(&text).expect("valid regions.toml");
+        assert!(back
+            .resolve(&take.labels)
+            .expect("resolves")
+            .contains_key("mouth"));
+        assert!(
+            text.contains("\"Face:BrowL\",  # name contains \"brow\""),
+            "{text}"
+        );
+
+        // Numbered markers, the face 200 mm tall along y: bands by height.
+        let mut take = Take::new((0..5).map(|i| format!("M{i}")).collect(), 100.0, 1);
+        let heights = [10.0, 90.0, 130.0, 190.0, 200.0];
+        let xyz: Vec<f32> = heights.iter().flat_map(|&h| [0.0, h, 0.0]).collect();
+        take.push_frame(&xyz, &[false; 5]);
+        let p = propose(&take);
+        let of = |r: &str| -> Vec<&str> {
+            p.iter()
+                .filter(|x| x.region == r)
+                .map(|x| x.label.as_str())
+                .collect()
+        };
+        assert_eq!(of("mouth"), ["M0"]);
+        assert_eq!(of("eyelids"), ["M2"]);
+        assert_eq!(of("eyebrows"), ["M3", "M4"]);
+    }
+}
