@@ -1,4 +1,5 @@
-//! OSC 1.0 wire formats of emoshift: marker frames, labels, output profiles and control; and
+//! OSC 1.0 wire formats of emoshift: marker frames, labels, output profiles and control;
+//! [`qtm`], Qualisys QTM's RT protocol (packets, commands, 3D data, parameters, events);
 //! [`natnet`], OptiTrack Motive's NatNet protocol (frames, model definitions, commands, a
 //! sans-IO client session) so the daemon can take Motive streams as a source.
 //!
@@ -68,6 +69,7 @@ mod frame;
 mod labels;
 pub mod natnet;
 mod output;
+pub mod qtm;
 mod reply;
 mod scan;
 mod timecode;
