@@ -70,6 +70,12 @@ pub struct ServeArgs {
     /// Also stream each performer's unedited input as a `<name>_raw` markerset (A/B).
     #[arg(long, requires = "natnet_server")]
     pub natnet_server_raw: bool,
+    /// Be a QTM server (Qualisys QTM's look) for QTM Connect for Unreal, Unity and
+    /// MotionBuilder and the Qualisys SDKs: the RT port, IP[:PORT] [default: 127.0.0.1:22223];
+    /// discovery is answered on UDP 22226. Beside QTM on one host pick another port.
+    #[arg(long, value_name = "IP:PORT", num_args = 0..=1,
+          default_missing_value = crate::serve::sinks::qtm::DEFAULT_QTM_SERVER)]
+    pub qtm_server: Option<String>,
 }
 
 /// The NatNet options `serve` and `record` share (each needs `--natnet`).

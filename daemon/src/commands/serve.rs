@@ -48,6 +48,9 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if let Some(m) = &args.monitor {
         raw.monitor = Some(m.clone());
     }
+    if let Some(q) = &args.qtm_server {
+        raw.qtm_server = Some(q.clone());
+    }
     raw.validate().map_err(|e| UsageError(e.to_string()).into())
 }
 

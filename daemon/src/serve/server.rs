@@ -32,6 +32,7 @@ use super::processing::{Processing, Shared};
 use super::queue::Queue;
 use super::sinks::natnet::{self as natnet_server, NatNetServer, NatNetSink};
 use super::sinks::osc::{OscOutput, OscOutputConfig};
+use super::sinks::qtm::{self as qtm_server, QtmServer, QtmSink};
 use super::sinks::recording::Recorder;
 use super::sinks::Outputs;
 use super::sources::natnet::{Link, NatNetStatus};
@@ -57,6 +58,8 @@ pub struct Bound {
     monitor: Option<tokio::net::TcpListener>,
     /// The NatNet server's sockets, when one is configured.
     natnet_server: Option<NatNetServer>,
+    /// The QTM server's sockets, when one is configured.
+    qtm_server: Option<QtmServer>,
 }
 
 /// Binds both sockets and loads the models, so that a test learns the addresses before frames
@@ -105,9 +108,14 @@ pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
         }
         None => None,
     };
+    let qtm_server = match &config.qtm_server {
+        Some(q) => Some(qtm_server::open(q, config.control_allow.clone())?),
+        None => None,
+    };
     Ok(Bound {
         monitor,
         natnet_server,
+        qtm_server,
         frames,
         replies,
         control,
@@ -181,6 +189,17 @@ impl Bound {
             .transpose()
     }
 
+    /// The QTM server's RT address, when it is served.
+    ///
+    /// # Errors
+    /// The OS cannot tell.
+    pub fn qtm_server_addr(&self) -> Result<Option<SocketAddr>> {
+        self.qtm_server
+            .as_ref()
+            .map(|q| q.tasks.local_addr())
+            .transpose()
+    }
+
     /// Serves until `shutdown` is cancelled, then drains and returns.
     ///
     /// # Errors
@@ -228,8 +247,9 @@ impl Bound {
         };
         let feed = self.config.monitor.map(|_| Feed::new(board));
         let pipeline = processing_pipeline(self.model, self.performers, &self.config);
-        let natnet_sink = spawn_natnet_server(self.natnet_server, &stats, &tracker, &shutdown);
-        let outputs = outputs(&self.config, feed, natnet_sink, self.control_news)?;
+        let servers = (self.natnet_server, self.qtm_server);
+        let sinks = spawn_servers(servers, &stats, &tracker, &shutdown);
+        let outputs = outputs(&self.config, feed, sinks, self.control_news)?;
         let window = self.config.poll_window;
         let processing = Processing::new((pipeline, outputs), window, (ends, cmd_rx), shared);
         let processing = tracker.spawn_blocking(move || processing.run());
@@ -271,7 +291,7 @@ fn processing_pipeline(
 fn outputs(
     config: &Config,
     feed: Option<Feed>,
-    natnet: Option<NatNetSink>,
+    (natnet, qtm): (Option<NatNetSink>, Option<QtmSink>),
     control_news: std::net::UdpSocket,
 ) -> Result<Outputs> {
     let osc = OscOutput::new(&OscOutputConfig {
@@ -286,6 +306,9 @@ fn outputs(
     if let Some(natnet) = natnet {
         others.push(Box::new(natnet));
     }
+    if let Some(qtm) = qtm {
+        others.push(Box::new(qtm));
+    }
     if let Some(feed) = feed {
         others.push(Box::new(feed));
     }
@@ -296,22 +319,34 @@ fn outputs(
     })
 }
 
-/// The NatNet server's command task, its status into `/status`; its frame sink.
-fn spawn_natnet_server(
-    server: Option<NatNetServer>,
+/// The NatNet and QTM servers' tasks when configured, their status into `/status`; their
+/// frame sinks.
+fn spawn_servers(
+    (natnet, qtm): (Option<NatNetServer>, Option<QtmServer>),
     stats: &Arc<Mutex<Stats>>,
     tracker: &TaskTracker,
     shutdown: &CancellationToken,
-) -> Option<NatNetSink> {
-    let server = server?;
+) -> (Option<NatNetSink>, Option<QtmSink>) {
+    let natnet = natnet.map(|server| {
+        let on_status = status_into(stats, "natnet_server");
+        tracker.spawn(server.commands.run(on_status, shutdown.clone()));
+        server.sink
+    });
+    let qtm = qtm.map(|q| q.spawn(status_into(stats, "qtm_server"), tracker, shutdown));
+    (natnet, qtm)
+}
+
+/// The `/status` pairs of the output `name`, into `stats`.
+fn status_into(
+    stats: &Arc<Mutex<Stats>>,
+    name: &'static str,
+) -> impl FnMut(Vec<(String, protocol::StatusValue)>) + Send + 'static {
     let stats = Arc::clone(stats);
-    let on_status = move |pairs| {
+    move |pairs| {
         if let Ok(mut s) = stats.lock() {
-            s.set_source_status("natnet_server", pairs);
+            s.set_source_status(name, pairs);
         }
-    };
-    tracker.spawn(server.commands.run(on_status, shutdown.clone()));
-    Some(server.sink)
+    }
 }
 
 /// Every source's task, its frames into `queue`: the OSC frame socket, the NatNet link when

@@ -117,6 +117,12 @@ pub struct RawConfig {
     /// The components profile's blend names (`emotion`, `speech1`, ...) to the names receivers
     /// want (an avatar's blendshapes).
     pub vmc_names: HashMap<String, String>,
+    /// The QTM server's RT address, `IP[:PORT]` (see [`super::sinks::qtm`]).
+    pub qtm_server: Option<String>,
+    /// QTM clients at most.
+    pub qtm_server_max_clients: Option<usize>,
+    /// Where QTM discovery is answered, `IP[:PORT]`, or `off`.
+    pub qtm_server_discovery: Option<String>,
     /// The monitor page's address (off when absent).
     pub monitor: Option<String>,
     /// The monitor page's token (generated and printed when the page is bound beyond
@@ -165,6 +171,8 @@ pub struct Config {
     pub natnet_server: Option<super::sinks::natnet::NatNetServerConfig>,
     /// The components profile's blend names to the names sent instead.
     pub vmc_names: HashMap<String, String>,
+    /// The QTM server, if any.
+    pub qtm_server: Option<super::sinks::qtm::QtmServerConfig>,
     /// The monitor page's address, if it is served.
     pub monitor: Option<SocketAddr>,
     /// The monitor page's token, if one is set.
@@ -204,6 +212,7 @@ impl RawConfig {
         let numbers = self.numbers()?;
         let natnet = self.take_natnet().validate()?;
         let natnet_server = self.take_natnet_server().validate()?;
+        let qtm_server = self.take_qtm_server().validate()?;
         let send = self
             .send
             .iter()
@@ -248,6 +257,7 @@ impl RawConfig {
             natnet,
             natnet_server,
             vmc_names: self.vmc_names,
+            qtm_server,
             monitor: self
                 .monitor
                 .map(|m| addr("monitor", Some(m), ""))
@@ -277,6 +287,15 @@ impl RawConfig {
             version: self.natnet_server_version.take(),
             raw: self.natnet_server_raw.take(),
             max_clients: self.natnet_server_max_clients.take(),
+        }
+    }
+
+    /// The `qtm_server*` keys, taken out for the QTM server's own check.
+    fn take_qtm_server(&mut self) -> super::sinks::qtm::RawQtmServer {
+        super::sinks::qtm::RawQtmServer {
+            server: self.qtm_server.take(),
+            max_clients: self.qtm_server_max_clients.take(),
+            discovery: self.qtm_server_discovery.take(),
         }
     }
 

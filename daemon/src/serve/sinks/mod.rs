@@ -16,6 +16,7 @@
 
 pub mod natnet;
 pub mod osc;
+pub mod qtm;
 pub mod recording;
 
 use engine::{Needs, Processed, Sink, StreamKey};

@@ -1,0 +1,276 @@
+#!/usr/bin/env python3
+"""The QTM checks of scripts/interop-qtm (run by it, loopback only). The peer is `qtm-rt`, the
+official Qualisys RT SDK for Python (PyPI, MIT): what it accepts, QTM Connect's C++ SDK reads
+the same way.
+
+Output: `emoshift serve --qtm-server` fed by `emoshift replay` (a synthetic face) with an
+emotion edit running. qtm-rt connects (protocol 1.25), asks the version, byte order, state;
+learns the labels from `GetParameters All` after the "parameters changed" event; is refused
+`TakeControl` with QTM's error packet; streams `3D` + `3DRes` over TCP on one connection and
+over UDP on another. Every frame the daemon's OSC compact output (`--send`, the truth) carries
+must reach both, with positions equal within 1e-3 mm and missing markers NaN.
+
+Prints PASS/FAIL per check and "N passed, M failed"; exit status 1 on any failure.
+"""
+
+import asyncio
+import math
+import os
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+import qtm_rt
+from qtm_rt.packet import QRTComponentType, QRTEvent, QRTPacket
+
+EMOSHIFT = os.environ["EMOSHIFT"]
+results = []
+
+
+def check(name, ok, detail=""):
+    print(("PASS " if ok else "FAIL ") + name + ("" if ok else ": " + str(detail)), flush=True)
+    results.append(bool(ok))
+
+
+def free_port(kind=socket.SOCK_DGRAM):
+    s = socket.socket(socket.AF_INET, kind)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def run(args):
+    return subprocess.run([EMOSHIFT] + args, check=True, stdout=subprocess.PIPE)
+
+
+def osc_messages(data):
+    """(address, tags, argument bytes) of every message, bundles flattened."""
+    if data.startswith(b"#bundle\0"):
+        out, off = [], 16
+        while off < len(data):
+            (n,) = struct.unpack_from(">I", data, off)
+            out += osc_messages(data[off + 4: off + 4 + n])
+            off += 4 + n
+        return out
+    a_end = data.index(b"\0")
+    t_at = (a_end + 4) & ~3
+    t_end = data.index(b"\0", t_at)
+    return [(data[:a_end].decode(), data[t_at + 1: t_end].decode(), data[(t_end + 4) & ~3:])]
+
+
+def osc_msg(addr, tags, payload):
+    def pad(s):
+        b = s.encode() + b"\0"
+        return b + b"\0" * (-len(b) % 4)
+    return pad(addr) + pad("," + tags) + payload
+
+
+def truth_of(datagrams):
+    """{frame number: mm positions} of the daemon's compact output."""
+    out = {}
+    for d in datagrams:
+        for addr, tags, args in osc_messages(d):
+            if addr == "/mocap/frame" and tags == "ihbb":
+                n, _t, mlen = struct.unpack_from(">iqI", args, 0)
+                at = 16 + ((mlen + 3) & ~3)
+                (plen,) = struct.unpack_from(">I", args, at)
+                blob = args[at + 4: at + 4 + plen]
+                out[n] = struct.unpack(f">{len(blob) // 4}f", blob)
+    return out
+
+
+def collect(sock, got, stop):
+    sock.settimeout(0.05)
+    while not stop.is_set():
+        try:
+            got.append(sock.recv(65536))
+        except socket.timeout:
+            pass
+
+
+def take(work):
+    run(["synth", "--out", f"{work}/session", "--seed", "5", "--sentences", "2",
+         "--emotions", "neutral,happy", "--format", "csv"])
+    src = f"{work}/session/s01_neutral.csv"
+    run(["train", src, "--out", f"{work}/model.json", "--components", "8",
+         "--restarts", "1", "--head-reference", "none"])
+    header = next(ln for ln in open(src) if ln.startswith("frame,"))
+    return src, [c[:-2] for c in header.strip().split(",")[2::3]]
+
+
+class Daemon:
+    """`emoshift serve --qtm-server`, its OSC compact output collected."""
+
+    def __init__(self, work, model):
+        self.rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.rx.bind(("127.0.0.1", 0))
+        self.listen, self.control = free_port(), free_port()
+        self.qtm = free_port(socket.SOCK_STREAM)
+        self.proc = subprocess.Popen(
+            [EMOSHIFT, "serve", "--model", model,
+             "--listen", f"127.0.0.1:{self.listen}", "--control", f"127.0.0.1:{self.control}",
+             "--send", f"127.0.0.1:{self.rx.getsockname()[1]}",
+             "--qtm-server", f"127.0.0.1:{self.qtm}"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        self.got, self.stop = [], threading.Event()
+        threading.Thread(target=collect, args=(self.rx, self.got, self.stop), daemon=True).start()
+        time.sleep(0.5)
+
+    def control_msg(self, msg):
+        ctl = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        ctl.bind(("127.0.0.1", 0))
+        ctl.settimeout(5)
+        ctl.sendto(msg, ("127.0.0.1", self.control))
+        return ctl.recv(65536)
+
+    def edit(self):
+        for msg in [osc_msg("/component/gain", "if", struct.pack(">if", 0, 1.6)),
+                    osc_msg("/emotion/alpha", "if", struct.pack(">if", 1, 1.5))]:
+            reply = self.control_msg(msg)
+            check("edit confirmed", b"/confirm" in reply.split(b"\0")[0], reply[:40])
+
+    def close(self):
+        self.proc.send_signal(signal.SIGTERM)
+        try:
+            _, err = self.proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            _, err = self.proc.communicate()
+        self.stop.set()
+        return self.proc.returncode, err.decode(errors="replace")
+
+
+def frames_of(packet, into):
+    """3D and 3DRes positions of a qtm-rt packet, by frame number."""
+    if QRTComponentType.Component3d in packet.components:
+        _, markers = packet.get_3d_markers()
+        into.setdefault("3d", {})[packet.framenumber] = [(m.x, m.y, m.z) for m in markers]
+    if QRTComponentType.Component3dRes in packet.components:
+        _, markers = packet.get_3d_markers_residual()
+        into.setdefault("3dres", {})[packet.framenumber] = [(m.x, m.y, m.z) for m in markers]
+
+
+class Udp(asyncio.DatagramProtocol):
+    def __init__(self, into):
+        self.into, self.errors = into, 0
+
+    def datagram_received(self, data, addr):
+        try:
+            size, kind = struct.unpack_from("<II", data, 0)
+            assert kind == 3 and size == len(data)
+            frames_of(QRTPacket(data[8:]), self.into)
+        except Exception:  # noqa: BLE001  (counted: every datagram must decode)
+            self.errors += 1
+
+
+async def clients(daemon, feed):
+    events = []
+    tcp = await qtm_rt.connect("127.0.0.1", port=daemon.qtm, version="1.25",
+                               on_event=events.append)
+    check("qtm-rt connects and agrees version 1.25", tcp is not None)
+    if tcp is None:
+        return None
+    check("QTMVersion answered", (await tcp.qtm_version()).startswith(b"QTM Version is"))
+    check("byte order little endian", await tcp.byte_order() == b"Byte order is little endian")
+    state = await tcp.get_state()
+    check("GetState answered with an event", isinstance(state, QRTEvent), state)
+    try:
+        await tcp.take_control("anything")
+        check("TakeControl refused with an error packet", False, "accepted")
+    except qtm_rt.QRTCommandException as e:
+        check("TakeControl refused with an error packet", b"refused" in str(e).encode(), e)
+    udp_conn = await qtm_rt.connect("127.0.0.1", port=daemon.qtm, version="1.25")
+    loop = asyncio.get_running_loop()
+    got_udp = {}
+    transport, udp = await loop.create_datagram_endpoint(lambda: Udp(got_udp),
+                                                         local_addr=("127.0.0.1", 0))
+    port = transport.get_extra_info("sockname")[1]
+    feed.start()
+    await tcp.await_event(QRTEvent.EventCameraSettingsChanged, timeout=20)
+    check("'parameters changed' event when the performer stream appears", True)
+    xml = (await tcp.get_parameters(["all"])).decode()
+    labels = [x.split("</Name>")[0] for x in xml.split("<Name>")[1:]]
+    check("GetParameters All: QTM_Parameters_Ver_1.25 with the frequency",
+          xml.startswith("<QTM_Parameters_Ver_1.25>") and "<Frequency>120</Frequency>" in xml,
+          xml[:200])
+    got_tcp = {}
+    await tcp.stream_frames(frames="allframes", components=["3d", "3dres"],
+                            on_packet=lambda p: frames_of(p, got_tcp))
+    await udp_conn._protocol.send_command(f"streamframes allframes udp:{port} 3d 3dres",
+                                          callback=False)
+    await asyncio.sleep(0.3)
+    while feed.is_alive():
+        await asyncio.sleep(0.1)
+    await asyncio.sleep(0.8)
+    await tcp.stream_frames_stop()
+    tcp.disconnect()
+    udp_conn.disconnect()
+    transport.close()
+    check("every UDP datagram decodes as a QTM data packet", udp.errors == 0, udp.errors)
+    return labels, got_tcp, got_udp
+
+
+def compare(what, truth, got, n_labels):
+    lost = sorted(set(truth) - set(got))
+    # The client subscribes once the stream is announced: the first frames go before.
+    first = min(got) if got else None
+    lost = [n for n in lost if first is None or n >= first]
+    check(f"{what}: every edited frame after the subscription arrives ({len(got)})",
+          got and not lost, f"{len(lost)} lost, first {lost[:5]}")
+    worst, compared, shape = 0.0, 0, True
+    for n, markers in got.items():
+        mm = truth.get(n)
+        if mm is None:
+            continue
+        shape &= len(markers) == n_labels and len(mm) == 3 * n_labels
+        for i, p in enumerate(markers):
+            if any(math.isnan(c) for c in p):
+                continue
+            for c, want in zip(p, mm[3 * i:3 * i + 3]):
+                worst = max(worst, abs(c - want))
+                compared += 1
+    check(f"{what}: positions equal the OSC compact output within 1e-3 mm "
+          f"({compared} coordinates)", shape and compared > 0 and worst <= 1e-3, worst)
+
+
+def output(work):
+    src, labels = take(work)
+    daemon = Daemon(work, f"{work}/model.json")
+    try:
+        daemon.edit()
+        feed = threading.Thread(target=run, args=(["replay", src, "--to",
+                                                   f"127.0.0.1:{daemon.listen}"],))
+        got = asyncio.run(clients(daemon, feed))
+        status = daemon.control_msg(osc_msg("/status", "", b""))
+        check("/status has qtm_server/frames_sent", b"qtm_server/frames_sent" in status)
+    finally:
+        code, err = daemon.close()
+    check("serve stops cleanly", code == 0, err[-400:])
+    if got is None:
+        return
+    served, got_tcp, got_udp = got
+    check("the labels are the model's markers, in order", served == labels,
+          (served[:3], labels[:3]))
+    truth = truth_of(daemon.got)
+    check("the daemon's OSC output has frames", len(truth) > 100, len(truth))
+    for what, into in [("TCP", got_tcp), ("UDP", got_udp)]:
+        for comp in ["3d", "3dres"]:
+            compare(f"{what} {comp}", truth, into.get(comp, {}), len(labels))
+
+
+def main():
+    with tempfile.TemporaryDirectory() as work:
+        output(work)
+    passed = sum(results)
+    print(f"{passed} passed, {len(results) - passed} failed")
+    sys.exit(0 if passed == len(results) else 1)
+
+
+if __name__ == "__main__":
+    main()
