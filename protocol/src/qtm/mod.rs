@@ -9,7 +9,8 @@
 //!   as a server reads them, refusals included.
 //! - [`data`]: data packets with the `3D`, `3DRes`, `3DNoLabels` and `Timecode` components,
 //!   both ways ([`encode_data_into`], [`decode_data_into`], no allocation when decoding).
-//! - [`params`]: the XML parameters (`General`'s frequency, `The_3D`'s labels).
+//! - [`params`], [`params_read`]: the XML parameters (`General`'s frequency, `The_3D`'s
+//!   labels), written as a server, read as a client (quick-xml).
 //! - [`event`]: QTM's events.
 //! - discovery on UDP [`DISCOVERY_PORT`]: [`decode_discover`], [`encode_discover_reply_into`].
 //!
@@ -39,6 +40,7 @@ pub mod error;
 pub mod event;
 pub mod packet;
 pub mod params;
+pub mod params_read;
 
 pub use command::{parse_command, Command, Components, ParameterSet, Rate, Transport};
 pub use data::{decode_data_into, encode_data_into, DataFrame, FrameIn, Timecode};
@@ -49,6 +51,7 @@ pub use packet::{
     PacketType, HEADER_BYTES,
 };
 pub use params::{encode_parameters_into, Parameters};
+pub use params_read::{decode_parameters, ParametersError, QtmParameters};
 
 /// QTM's little-endian RT port (TCP).
 pub const DEFAULT_PORT: u16 = 22223;
