@@ -10,6 +10,10 @@ learns the labels from `GetParameters All` after the "parameters changed" event;
 over UDP on another. Every frame the daemon's OSC compact output (`--send`, the truth) carries
 must reach both, with positions equal within 1e-3 mm and missing markers NaN.
 
+Chain: that server (fed by replay, proven above) is the QTM stand-in. `emoshift record --qtm`
+from it writes the frames it served; `serve --qtm` takes them live, edits them and serves them
+again through its own `--qtm-server` to qtm-rt, QTM's frame numbers kept.
+
 Prints PASS/FAIL per check and "N passed, M failed"; exit status 1 on any failure.
 """
 
@@ -107,7 +111,7 @@ def take(work):
 class Daemon:
     """`emoshift serve --qtm-server`, its OSC compact output collected."""
 
-    def __init__(self, work, model):
+    def __init__(self, work, model, extra=()):
         self.rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.rx.bind(("127.0.0.1", 0))
         self.listen, self.control = free_port(), free_port()
@@ -116,7 +120,7 @@ class Daemon:
             [EMOSHIFT, "serve", "--model", model,
              "--listen", f"127.0.0.1:{self.listen}", "--control", f"127.0.0.1:{self.control}",
              "--send", f"127.0.0.1:{self.rx.getsockname()[1]}",
-             "--qtm-server", f"127.0.0.1:{self.qtm}"],
+             "--qtm-server", f"127.0.0.1:{self.qtm}"] + list(extra),
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         self.got, self.stop = [], threading.Event()
         threading.Thread(target=collect, args=(self.rx, self.got, self.stop), daemon=True).start()
@@ -264,9 +268,85 @@ def output(work):
             compare(f"{what} {comp}", truth, into.get(comp, {}), len(labels))
 
 
+async def stream_numbers(port, seconds_idle=1.5):
+    """qtm-rt streams 3D over TCP from `port` until frames stop: {frame number: positions}."""
+    conn = await qtm_rt.connect("127.0.0.1", port=port, version="1.25")
+    if conn is None:
+        return None
+    got, last = {}, [time.time()]
+
+    def on_packet(p):
+        frames_of(p, got)
+        last[0] = time.time()
+    await conn.await_event(QRTEvent.EventCameraSettingsChanged, timeout=20)
+    await conn.stream_frames(frames="allframes", components=["3d"], on_packet=on_packet)
+    while time.time() - last[0] < seconds_idle:
+        await asyncio.sleep(0.1)
+    conn.disconnect()
+    return got.get("3d", {})
+
+
+def read_csv(path):
+    """{frame number: mm positions (NaN for gaps)} of an emoshift CSV take."""
+    out = {}
+    for ln in open(path):
+        if ln.startswith("#") or ln.startswith("frame,"):
+            continue
+        cells = ln.strip().split(",")
+        out[int(cells[0])] = [math.nan if c == "" else float(c) for c in cells[2:]]
+    return out
+
+
+def chain(work):
+    src, labels = f"{work}/session/s01_neutral.csv", None
+    stand_in = Daemon(work, f"{work}/model.json")
+    edited = Daemon(work, f"{work}/model.json", ["--qtm", f"127.0.0.1:{stand_in.qtm}"])
+    rec = subprocess.Popen([EMOSHIFT, "record", "--qtm", f"127.0.0.1:{stand_in.qtm}",
+                            "--out", f"{work}/rec.csv", "--seconds", "3"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        edited.edit()
+        time.sleep(0.5)
+        feed = threading.Thread(target=run, args=(["replay", src, "--to",
+                                                   f"127.0.0.1:{stand_in.listen}"],))
+        feed.start()
+        got = asyncio.run(stream_numbers(edited.qtm))
+        feed.join()
+        out, err = rec.communicate(timeout=20)
+        check("record --qtm ends by itself and writes the take", rec.returncode == 0,
+              err.decode(errors="replace")[-400:])
+    finally:
+        edited_code, edited_err = edited.close()
+        code, err = stand_in.close()
+    check("both daemons stop cleanly", code == 0 and edited_code == 0,
+          (err[-300:], edited_err[-300:]))
+    served = truth_of(stand_in.got)
+    recorded = read_csv(f"{work}/rec.csv") if os.path.exists(f"{work}/rec.csv") else {}
+    common = [n for n in recorded if n in served]
+    worst = max((abs(a - b) for n in common for a, b in zip(recorded[n], served[n])
+                 if not math.isnan(a)), default=math.inf)
+    check(f"record --qtm: the frames the stand-in served, QTM's numbers ({len(common)} frames)",
+          len(common) > 100 and len(common) == len(recorded), (len(common), len(recorded)))
+    check("record --qtm: positions as served within 1e-3 mm", worst <= 1e-3, worst)
+    truth = truth_of(edited.got)
+    check("serve --qtm: the edited daemon processed the stand-in's frames", len(truth) > 100,
+          len(truth))
+    check("serve --qtm: its frames keep the stand-in's frame numbers",
+          truth and set(truth) <= set(served), sorted(set(truth) - set(served))[:5])
+    moved = max((abs(a - b) for n in truth if n in served
+                 for a, b in zip(truth[n], served[n])), default=0.0)
+    check("serve --qtm: the edit changes the face live", moved > 0.01, moved)
+    if got is None:
+        check("chain: qtm-rt connects to the edited daemon's --qtm-server", False)
+        return
+    compare("chain (stand-in -> serve --qtm -> --qtm-server -> qtm-rt)", truth, got,
+            len(next(iter(got.values()))) if got else 0)
+
+
 def main():
     with tempfile.TemporaryDirectory() as work:
         output(work)
+        chain(work)
     passed = sum(results)
     print(f"{passed} passed, {len(results) - passed} failed")
     sys.exit(0 if passed == len(results) else 1)

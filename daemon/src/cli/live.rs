@@ -49,6 +49,10 @@ pub struct ServeArgs {
     /// The NatNet source's settings.
     #[command(flatten)]
     pub natnet_options: NatNetArgs,
+    /// Take frames from Qualisys QTM's real-time output too: HOST[:PORT] [port 22223]. One
+    /// stream of every label, or one per performer with `qtm_performers` in the config.
+    #[arg(long, value_name = "HOST[:PORT]")]
+    pub qtm: Option<String>,
     /// Be a NatNet server (Motive's look) for OptiTrack's Unreal, Unity and MotionBuilder
     /// plugins and NatNet clients: the command port, IP[:PORT] [default: 127.0.0.1:1510]; the
     /// data port is PORT+1. Beside Motive on one host pick other ports, e.g. 127.0.0.1:1512.
@@ -155,6 +159,9 @@ pub struct RecordArgs {
     /// The NatNet source's settings.
     #[command(flatten)]
     pub natnet_options: NatNetArgs,
+    /// Take frames from Qualisys QTM's real-time output: HOST[:PORT] [port 22223].
+    #[arg(long, value_name = "HOST[:PORT]")]
+    pub qtm: Option<String>,
     /// The file, .c3d, .trc or .csv.
     #[arg(long)]
     pub out: PathBuf,

@@ -1,4 +1,4 @@
-//! `emoshift record`: a live source (an OSC frame socket or a NatNet server) captured to one
+//! `emoshift record`: a live source (an OSC frame socket, a NatNet server or QTM) captured to one
 //! file for training; Ctrl-C leaves the file complete. The capture is [`crate::serve::capture`].
 
 use anyhow::{Context, Result};
@@ -11,17 +11,25 @@ use crate::serve::capture::{self, CaptureConfig, Notice, Source};
 
 /// The arguments, checked.
 fn config(args: &RecordArgs) -> Result<CaptureConfig> {
-    let source = match (&args.listen, &args.natnet) {
-        (Some(l), None) => Source::Osc(
+    let source = match (&args.listen, &args.natnet, &args.qtm) {
+        (None, None, Some(server)) => {
+            let raw = crate::serve::sources::qtm::RawQtm {
+                server: Some(server.clone()),
+                performers: Default::default(),
+            };
+            let q = raw.validate().map_err(|e| UsageError(e.to_string()))?;
+            Source::Qtm(q.expect("a server was given"))
+        }
+        (Some(l), None, None) => Source::Osc(
             l.parse()
                 .map_err(|_| UsageError(format!("--listen: {l:?} is not an IP:PORT address")))?,
         ),
-        (None, Some(server)) => {
+        (None, Some(server), None) => {
             let raw = args.natnet_options.raw(Some(server.clone()));
             let n = raw.validate().map_err(|e| UsageError(e.to_string()))?;
             Source::NatNet(n.expect("a server was given"))
         }
-        _ => return Err(UsageError("give one source: --listen or --natnet".into()).into()),
+        _ => return Err(UsageError("give one source: --listen, --natnet or --qtm".into()).into()),
     };
     if replay::Format::from_path(&args.out).is_none() {
         return Err(UsageError(format!(

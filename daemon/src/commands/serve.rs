@@ -51,6 +51,9 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if let Some(q) = &args.qtm_server {
         raw.qtm_server = Some(q.clone());
     }
+    if let Some(q) = &args.qtm {
+        raw.qtm = Some(q.clone());
+    }
     raw.validate().map_err(|e| UsageError(e.to_string()).into())
 }
 

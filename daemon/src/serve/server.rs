@@ -15,7 +15,6 @@
 use std::net::SocketAddr;
 use std::sync::atomic::AtomicU64;
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 
 use anyhow::{Context, Result};
 use engine::pipeline::{Pipeline, PipelineConfig};
@@ -37,9 +36,13 @@ use super::sinks::recording::Recorder;
 use super::sinks::Outputs;
 use super::sources::natnet::{Link, NatNetStatus};
 use super::sources::osc::OscSource;
+use super::sources::qtm::{self, QtmConfig, QtmStatus};
 use super::sources::{Answer, Arrival, InputCounters};
-use super::stats::Stats;
+use super::stats::{log_stats, status_into, Stats};
 use super::Config;
+
+/// The QTM source's settings and counters.
+type QtmInput = (QtmConfig, Arc<InputCounters>);
 
 /// A server with its sockets bound and its models loaded; [`Bound::run`] serves.
 #[derive(Debug)]
@@ -207,8 +210,8 @@ impl Bound {
     pub async fn run(self, shutdown: CancellationToken) -> Result<()> {
         let tracker = TaskTracker::new();
         let osc = Arc::new(InputCounters::named("osc"));
-        let natnet_counters = self.natnet.as_ref().map(|n| Arc::clone(&n.1));
-        let stats = new_stats(&self.config, [Some(Arc::clone(&osc)), natnet_counters]);
+        let qtm = (self.config.qtm.clone()).map(|q| (q, Arc::new(InputCounters::named("qtm"))));
+        let stats = new_stats(&self.config, &osc, (&self.natnet, &qtm));
         let shared = Shared {
             stats: Arc::clone(&stats),
             queue_dropped: Arc::new(AtomicU64::new(0)),
@@ -254,7 +257,7 @@ impl Bound {
         let processing = Processing::new((pipeline, outputs), window, (ends, cmd_rx), shared);
         let processing = tracker.spawn_blocking(move || processing.run());
         let link = self.natnet.map(|n| n.0);
-        spawn_sources((source, link), (queue, &stats), &tracker, &shutdown);
+        spawn_sources((source, link, qtm), (queue, &stats), &tracker, &shutdown);
         tracker.spawn(control::run(ctx.clone(), shutdown.clone()));
         tracker.spawn(control::reload_on_sighup(ctx, shutdown.clone()));
         tracker.spawn(log_stats(stats, every, shutdown.clone()));
@@ -266,10 +269,18 @@ impl Bound {
 }
 
 /// The shared stats, with the model's file and each source's counters.
-fn new_stats(config: &Config, inputs: [Option<Arc<InputCounters>>; 2]) -> Arc<Mutex<Stats>> {
+fn new_stats(
+    config: &Config,
+    osc: &Arc<InputCounters>,
+    (natnet, qtm): (&Option<(Link, Arc<InputCounters>)>, &Option<QtmInput>),
+) -> Arc<Mutex<Stats>> {
     let mut stats = Stats::new();
     stats.model = config.model.display().to_string();
-    stats.inputs.extend(inputs.into_iter().flatten());
+    stats.inputs.push(Arc::clone(osc));
+    stats
+        .inputs
+        .extend(natnet.as_ref().map(|n| Arc::clone(&n.1)));
+    stats.inputs.extend(qtm.as_ref().map(|q| Arc::clone(&q.1)));
     Arc::new(Mutex::new(stats))
 }
 
@@ -336,23 +347,10 @@ fn spawn_servers(
     (natnet, qtm)
 }
 
-/// The `/status` pairs of the output `name`, into `stats`.
-fn status_into(
-    stats: &Arc<Mutex<Stats>>,
-    name: &'static str,
-) -> impl FnMut(Vec<(String, protocol::StatusValue)>) + Send + 'static {
-    let stats = Arc::clone(stats);
-    move |pairs| {
-        if let Ok(mut s) = stats.lock() {
-            s.set_source_status(name, pairs);
-        }
-    }
-}
-
 /// Every source's task, its frames into `queue`: the OSC frame socket, the NatNet link when
 /// configured (its status into `stats`). A new source is one more task here.
 fn spawn_sources(
-    (osc, natnet_link): (OscSource, Option<Link>),
+    (osc, natnet_link, qtm): (OscSource, Option<Link>, Option<QtmInput>),
     (queue, stats): (Queue, &Arc<Mutex<Stats>>),
     tracker: &TaskTracker,
     shutdown: &CancellationToken,
@@ -360,6 +358,20 @@ fn spawn_sources(
     if let Some(link) = natnet_link {
         let stats = Arc::clone(stats);
         tracker.spawn(natnet(link, queue.clone(), stats, shutdown.clone()));
+    }
+    if let Some((config, counters)) = qtm {
+        let (stats, queue, shutdown) = (Arc::clone(stats), queue.clone(), shutdown.clone());
+        tracker.spawn(async move {
+            let mut sink = |frame: &SourceFrame<'_>, arrival: &Arrival| {
+                queue.push(frame, arrival);
+            };
+            let mut on_status = |st: &QtmStatus| {
+                if let Ok(mut s) = stats.lock() {
+                    s.set_source_status("qtm", st.pairs());
+                }
+            };
+            let _ = qtm::run(config, counters, shutdown, &mut sink, &mut on_status).await;
+        });
     }
     tracker.spawn(receive(osc, queue, shutdown.clone()));
 }
@@ -384,17 +396,5 @@ async fn natnet(link: Link, queue: Queue, stats: Arc<Mutex<Stats>>, shutdown: Ca
     };
     if let Err(e) = link.run(shutdown, &mut sink, &mut on_status).await {
         tracing::error!(target: "emoshift", error = %format!("{e:#}"), "natnet: the source stopped");
-    }
-}
-
-/// Logs the status every `every` until shutdown.
-async fn log_stats(stats: Arc<Mutex<Stats>>, every: Duration, shutdown: CancellationToken) {
-    let mut tick = tokio::time::interval(every);
-    tick.tick().await;
-    loop {
-        tokio::select! {
-            () = shutdown.cancelled() => break,
-            _ = tick.tick() => if let Ok(s) = stats.lock() { s.log() },
-        }
     }
 }

@@ -311,5 +311,34 @@ fn subscriber_pairs(n: usize, sub: &SubscriberStatus, out: &mut Vec<(String, Sta
     out.push((format!("{at}/backing_off"), int(u64::from(sub.backing_off))));
 }
 
+/// The `/status` pairs of the output `name`, into `stats`.
+pub fn status_into(
+    stats: &Arc<std::sync::Mutex<Stats>>,
+    name: &'static str,
+) -> impl FnMut(Vec<(String, protocol::StatusValue)>) + Send + 'static {
+    let stats = Arc::clone(stats);
+    move |pairs| {
+        if let Ok(mut s) = stats.lock() {
+            s.set_source_status(name, pairs);
+        }
+    }
+}
+
+/// Logs the status every `every` until shutdown.
+pub async fn log_stats(
+    stats: Arc<std::sync::Mutex<Stats>>,
+    every: std::time::Duration,
+    shutdown: tokio_util::sync::CancellationToken,
+) {
+    let mut tick = tokio::time::interval(every);
+    tick.tick().await;
+    loop {
+        tokio::select! {
+            () = shutdown.cancelled() => break,
+            _ = tick.tick() => if let Ok(s) = stats.lock() { s.log() },
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests;

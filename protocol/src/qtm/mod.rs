@@ -61,6 +61,8 @@ pub const DISCOVERY_PORT: u16 = 22226;
 pub const WELCOME: &str = "QTM RT Interface connected";
 /// The newest protocol version emoshift speaks (as a server and as a client).
 pub const VERSION: (u32, u32) = (1, 25);
+/// The command that agrees [`VERSION`] (as a client).
+pub const MAX_VERSION_TEXT: &str = "Version 1.25";
 /// The oldest it accepts from a client (qtm-rt needs 1.8 or later).
 pub const MIN_VERSION: (u32, u32) = (1, 8);
 

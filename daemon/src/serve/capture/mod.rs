@@ -20,6 +20,7 @@ use tokio_util::sync::CancellationToken;
 use super::allow::AllowList;
 use super::sources::natnet::{Link, NatNetConfig, NatNetStatus};
 use super::sources::osc::OscSource;
+use super::sources::qtm::{QtmConfig, QtmStatus};
 use super::sources::{Answer, Arrival, InputCounters};
 use take::{Captured, Incoming, Take};
 
@@ -61,6 +62,8 @@ pub enum Source {
     Osc(SocketAddr),
     /// A NatNet server.
     NatNet(NatNetConfig),
+    /// Qualisys QTM.
+    Qtm(QtmConfig),
 }
 
 /// What to capture.
@@ -185,6 +188,7 @@ pub async fn run(
     match &config.source {
         Source::Osc(addr) => osc(*addr, &state, &stop, &mut sink, notice).await?,
         Source::NatNet(n) => natnet(n.clone(), &state, &stop, &mut sink, notice).await?,
+        Source::Qtm(q) => qtm(q.clone(), &state, &stop, &mut sink, notice).await?,
     }
     let state = state
         .into_inner()
@@ -268,6 +272,39 @@ async fn natnet(
         lock(state).tick(started, || natnet_quiet(server, st), notice);
     };
     link.run(stop.clone(), sink, &mut on_status).await
+}
+
+/// The QTM source until `stop`, with a quiet notice while nothing comes.
+async fn qtm(
+    q: QtmConfig,
+    state: &Mutex<State>,
+    stop: &CancellationToken,
+    sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
+    notice: &mut (dyn FnMut(&str) + Send),
+) -> Result<()> {
+    let started = Instant::now();
+    let mut on_status = |st: &QtmStatus| {
+        let line = lock(state).quiet_notice(started, || {
+            let secs = QUIET.as_secs();
+            match st.connected {
+                false => format!(
+                    "no session with QTM at {} for {secs} s: is QTM running there with \
+                     real-time output on (Project Options > Real-Time Output)?",
+                    st.server
+                ),
+                true => format!(
+                    "connected to QTM at {}, but no frames for {secs} s: is a measurement \
+                     running (or RT from file), with 3D tracking on?",
+                    st.server
+                ),
+            }
+        });
+        if let Some(line) = line {
+            notice(&line);
+        }
+    };
+    let counters = Arc::new(InputCounters::named("qtm"));
+    super::sources::qtm::run(q, counters, stop.clone(), sink, &mut on_status).await
 }
 
 /// Why nothing arrives from a NatNet server, as far as the session can tell.

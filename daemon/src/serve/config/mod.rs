@@ -117,6 +117,10 @@ pub struct RawConfig {
     /// The components profile's blend names (`emotion`, `speech1`, ...) to the names receivers
     /// want (an avatar's blendshapes).
     pub vmc_names: HashMap<String, String>,
+    /// QTM's RT address, `HOST[:PORT]`: a QTM source (see [`super::sources::qtm`]).
+    pub qtm: Option<String>,
+    /// QTM performers: name to label pattern (`alice = "Alice_*"`).
+    pub qtm_performers: std::collections::BTreeMap<String, String>,
     /// The QTM server's RT address, `IP[:PORT]` (see [`super::sinks::qtm`]).
     pub qtm_server: Option<String>,
     /// QTM clients at most.
@@ -171,6 +175,8 @@ pub struct Config {
     pub natnet_server: Option<super::sinks::natnet::NatNetServerConfig>,
     /// The components profile's blend names to the names sent instead.
     pub vmc_names: HashMap<String, String>,
+    /// The QTM source, if any.
+    pub qtm: Option<super::sources::qtm::QtmConfig>,
     /// The QTM server, if any.
     pub qtm_server: Option<super::sinks::qtm::QtmServerConfig>,
     /// The monitor page's address, if it is served.
@@ -213,6 +219,7 @@ impl RawConfig {
         let natnet = self.take_natnet().validate()?;
         let natnet_server = self.take_natnet_server().validate()?;
         let qtm_server = self.take_qtm_server().validate()?;
+        let qtm = self.take_qtm().validate()?;
         let send = self
             .send
             .iter()
@@ -258,6 +265,7 @@ impl RawConfig {
             natnet_server,
             vmc_names: self.vmc_names,
             qtm_server,
+            qtm,
             monitor: self
                 .monitor
                 .map(|m| addr("monitor", Some(m), ""))
@@ -287,6 +295,14 @@ impl RawConfig {
             version: self.natnet_server_version.take(),
             raw: self.natnet_server_raw.take(),
             max_clients: self.natnet_server_max_clients.take(),
+        }
+    }
+
+    /// The `qtm` and `qtm_performers` keys, taken out for the QTM source's own check.
+    fn take_qtm(&mut self) -> super::sources::qtm::RawQtm {
+        super::sources::qtm::RawQtm {
+            server: self.qtm.take(),
+            performers: std::mem::take(&mut self.qtm_performers),
         }
     }
 

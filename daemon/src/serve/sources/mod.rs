@@ -4,13 +4,15 @@
 //! one protocol knows stays in its folder.
 //!
 //! - [`osc`]: the OSC frame socket: `/mocap/labels`, `/mocap/frame`, `/mocap/timecode`;
-//! - [`natnet`]: OptiTrack Motive's NatNet stream: model definitions, frames, clock offset.
+//! - [`natnet`]: OptiTrack Motive's NatNet stream: model definitions, frames, clock offset;
+//! - [`qtm`]: Qualisys QTM's RT stream: parameters, 3D frames with timecode, events.
 //!
 //! A new source (QTM next) is its codec in `protocol`, one folder here with a `run(config,
 //! sink, shutdown)` task, and its config keys; `serve` and `record` start it like the others.
 
 pub mod natnet;
 pub mod osc;
+pub mod qtm;
 
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicU64, Ordering};
