@@ -10,7 +10,7 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
-all="frame datagram control labels outputs natnet natnet_server c3d trc csv"
+all="frame datagram control labels outputs natnet natnet_server qtm_client qtm_server c3d trc csv"
 limit="-runs=${RUNS:-1000000}"
 [ -n "${SECONDS_PER_TARGET:-}" ] && limit="-max_total_time=$SECONDS_PER_TARGET"
 failed=0
