@@ -210,7 +210,7 @@ fn parse_stream<'a>(mut words: impl Iterator<Item = &'a str>) -> Command<'a> {
     let mut words = words.peekable();
     let mut transport = Transport::Tcp;
     if let Some(w) = words.peek() {
-        if w.len() >= 3 && w[..3].eq_ignore_ascii_case("udp") {
+        if w.get(..3).is_some_and(|p| p.eq_ignore_ascii_case("udp")) {
             match parse_udp(w) {
                 Some(t) => transport = t,
                 None => return Command::Unknown,
@@ -227,7 +227,7 @@ fn parse_stream<'a>(mut words: impl Iterator<Item = &'a str>) -> Command<'a> {
 
 /// `UDP:port` or `UDP:ip:port` (`UDP` alone: port 0, the caller refuses it).
 fn parse_udp(word: &str) -> Option<Transport> {
-    let rest = &word[3..];
+    let rest = word.get(3..)?;
     if rest.is_empty() {
         return Some(Transport::Udp { ip: None, port: 0 });
     }

@@ -112,6 +112,14 @@ fn commands_parse_as_qtm_reads_them() {
     assert_eq!(parse_command("calibrate"), Command::Refused("calibrate"));
     assert_eq!(parse_command("dance"), Command::Unknown);
     assert_eq!(parse_command(""), Command::Unknown);
+    // Found by fuzz/qtm_server: a multi-byte character where "UDP" would be.
+    assert!(matches!(
+        parse_command("StreamFrames AllFrames UD\u{62f}P:4545 3D"),
+        Command::StreamFrames {
+            components: Err(_),
+            ..
+        }
+    ));
 }
 
 #[test]
