@@ -41,7 +41,6 @@ use super::sources::{Answer, Arrival, InputCounters};
 use super::stats::{log_stats, status_into, Stats};
 use super::Config;
 
-/// The QTM source's settings and counters.
 type QtmInput = (QtmConfig, Arc<InputCounters>);
 
 /// A server with its sockets bound and its models loaded; [`Bound::run`] serves.

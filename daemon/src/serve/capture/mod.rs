@@ -280,28 +280,29 @@ async fn qtm(
     state: &Mutex<State>,
     stop: &CancellationToken,
     sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
-    notice: &mut (dyn FnMut(&str) + Send),
+    notice: &mut OnNotice<'_>,
 ) -> Result<()> {
     let started = Instant::now();
     let mut on_status = |st: &QtmStatus| {
-        let line = lock(state).quiet_notice(started, || {
-            let secs = QUIET.as_secs();
-            match st.connected {
-                false => format!(
-                    "no session with QTM at {} for {secs} s: is QTM running there with \
+        lock(state).tick(
+            started,
+            || {
+                let secs = QUIET.as_secs();
+                match st.connected {
+                    false => format!(
+                        "no session with QTM at {} for {secs} s: is QTM running there with \
                      real-time output on (Project Options > Real-Time Output)?",
-                    st.server
-                ),
-                true => format!(
-                    "connected to QTM at {}, but no frames for {secs} s: is a measurement \
+                        st.server
+                    ),
+                    true => format!(
+                        "connected to QTM at {}, but no frames for {secs} s: is a measurement \
                      running (or RT from file), with 3D tracking on?",
-                    st.server
-                ),
-            }
-        });
-        if let Some(line) = line {
-            notice(&line);
-        }
+                        st.server
+                    ),
+                }
+            },
+            notice,
+        );
     };
     let counters = Arc::new(InputCounters::named("qtm"));
     super::sources::qtm::run(q, counters, stop.clone(), sink, &mut on_status).await
