@@ -52,12 +52,6 @@ pub const MIN_SENTENCES_PER_EMOTION: usize = 8;
 /// DTW band as a share of the longer take of a pair: the generator's warps stay within ±20 %.
 pub const DTW_BAND_SHARE: f64 = 0.25;
 
-/// Sentences each emotion should be recorded in: the default script of `emoshift session`
-/// records this many, and `analyze` advises at least this many. Provisional: the same count as
-/// `synth`'s and the demo's default session (8 sentences), which trains and analyses to the
-/// generator's roles; the measured curve of `docs/session.md` is to confirm or replace it.
-pub const MIN_SENTENCES_PER_EMOTION: usize = 8;
-
 /// One analysed take.
 #[derive(Debug, Clone, Serialize)]
 pub struct TakeSummary {

@@ -54,10 +54,10 @@ pub enum Refusal {
         missing: usize,
     },
     /// The stream's labels changed while recording.
-    #[error("the marker labels changed {changes} times during the take (the frames after the change are not in it): keep the capture system's labelling fixed, then retake")]
+    #[error("the marker labels changed during the take ({frames} frames came with other labels and are not in it): keep the capture system's labelling fixed, then retake")]
     LabelsChanged {
-        /// Changes seen.
-        changes: u64,
+        /// Frames with other labels.
+        frames: u64,
     },
     /// The same frames as the previous take.
     #[error("the take is a copy of the previous one ({frames} identical frames): is the source replaying? Then retake")]
@@ -67,14 +67,15 @@ pub enum Refusal {
     },
 }
 
-/// Checks `take` (`label_changes` as the capture counted them) against `expect` and the
+/// Checks `take` (`relabelled`: its stream's frames that came with other labels, as the
+/// capture counted them) against `expect` and the
 /// previous accepted take.
 ///
 /// # Errors
 /// The first check it fails.
 pub fn check(
     take: &Take,
-    label_changes: u64,
+    relabelled: u64,
     expect: &Expect<'_>,
     previous: Option<&Take>,
 ) -> Result<(), Refusal> {
@@ -82,10 +83,8 @@ pub fn check(
     if frames == 0 {
         return Err(Refusal::Empty);
     }
-    if label_changes > 0 {
-        return Err(Refusal::LabelsChanged {
-            changes: label_changes,
-        });
+    if relabelled > 0 {
+        return Err(Refusal::LabelsChanged { frames: relabelled });
     }
     let seconds = frames as f64 / take.rate_hz;
     let (shortest, longest) = expect.seconds;
@@ -175,7 +174,7 @@ mod tests {
         ));
         assert!(matches!(
             check(&good, 2, &expect(), None),
-            Err(Refusal::LabelsChanged { changes: 2 })
+            Err(Refusal::LabelsChanged { frames: 2 })
         ));
         assert_eq!(
             check(&good, 0, &expect(), Some(&good)),

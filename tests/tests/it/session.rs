@@ -1,0 +1,274 @@
+//! Issue 33: `emoshift session` driven by a scripted performer over its OSC control. For each
+//! prompt the performer replays, into the session's OSC source, the matching take of a
+//! synthetic paired session (sentence k in emotion e), then stops. Along the way a take with
+//! most markers missing is refused and retaken, and the process is killed mid-take and
+//! resumed. The written session then trains and analyses to the same roles and emotion
+//! space as the synthetic session's own manifest.
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use daemon::loopback;
+use ica_core::model::IcaModel;
+use protocol::{Control, Labels, Reply, SessionControl, SessionStatus};
+
+use super::support::*;
+
+/// The take refused for missing markers, then retaken.
+const GAPPY_TAKE: i32 = 2;
+/// The take the process is killed in, then offered again after `--resume`.
+const KILLED_TAKE: i32 = 5;
+
+fn emoshift(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"))
+        .args(args)
+        .output()
+        .expect("the binary runs");
+    assert!(
+        out.status.success(),
+        "emoshift {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn spawn_session(dir: &Path, synth: &Path, listen: u16, control: u16, resume: bool) -> Child {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"));
+    cmd.arg("session")
+        .arg(dir)
+        .args(["--listen", &format!("127.0.0.1:{listen}")])
+        .args(["--control", &format!("127.0.0.1:{control}")])
+        .arg("--regions")
+        .arg(synth.join("regions.toml"))
+        .arg("--no-keyboard")
+        .stdout(Stdio::null())
+        .stderr(Stdio::inherit());
+    if resume {
+        cmd.arg("--resume");
+    }
+    cmd.spawn().expect("the binary starts")
+}
+
+async fn status(control: &ControlClient) -> SessionStatus {
+    let ask = Control::Session(SessionControl::Status);
+    match control.send_when_up(&ask).await {
+        Some(Reply::SessionStatus(s)) => s,
+        other => panic!("no session status: {other:?}"),
+    }
+}
+
+async fn send(control: &ControlClient, c: SessionControl) -> Reply {
+    control.send(&Control::Session(c)).await
+}
+
+/// Sends `frames` frames of `take` (all when `None`), `gone` of its markers missing, frame
+/// numbers from `first`; a 1 ms pause every 8 frames keeps loopback's buffers from filling.
+async fn perform(to: u16, take: &replay::Take, frames: Option<usize>, gone: usize, first: i32) {
+    let labels = Labels {
+        layout_id: 0,
+        names: take.labels.clone(),
+    };
+    let addr = format!("127.0.0.1:{to}").parse().expect("addr");
+    let mut source = loopback::Source::on_loopback(&labels, addr).expect("a loopback source");
+    let m = take.n_markers();
+    let missing: Vec<bool> = (0..m).map(|k| k < gone).collect();
+    let step_us = (1e6 / take.rate_hz) as i64;
+    for f in 0..frames.unwrap_or(take.n_frames()) {
+        let n = first + f as i32;
+        let xyz = &take.positions[f * m * 3..(f + 1) * m * 3];
+        source
+            .send_frame(n, i64::from(n) * step_us, xyz, &missing)
+            .expect("finite");
+        if f % 8 == 7 {
+            tokio::time::sleep(Duration::from_millis(1)).await;
+        }
+    }
+    // The last datagrams reach the session before the stop does.
+    tokio::time::sleep(Duration::from_millis(50)).await;
+}
+
+fn trained(dir: &Path) -> IcaModel {
+    let path = dir.join("model.json");
+    let file = std::fs::File::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    IcaModel::load(std::io::BufReader::new(file)).expect("a model")
+}
+
+fn sigkill(child: &mut Child) {
+    let status = Command::new("kill")
+        .args(["-KILL", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(status.success());
+    child.wait().expect("the child is reaped");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn issue_33_a_scripted_performer_records_a_session_that_trains_like_its_source() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let synth = tmp.path().join("synth");
+    let s = synth.to_str().expect("utf-8");
+    emoshift(&["synth", "--out", s, "--emotions", "neutral,happy,sad,angry"]);
+    let dir = tmp.path().join("perf");
+    let (fp, cp) = (free_port(), free_port());
+    let mut child = spawn_session(&dir, &synth, fp, cp, false);
+    let control = ControlClient::new(format!("127.0.0.1:{cp}").parse().expect("addr")).await;
+    let (mut frame, mut gappy_done, mut killed) = (0i32, false, false);
+    let (started, mut waited) = (Instant::now(), Duration::ZERO);
+    loop {
+        let st = status(&control).await;
+        if st.state == "done" {
+            break;
+        }
+        assert_eq!(st.state, "waiting", "{st:?}");
+        let file = synth.join(format!("s{:02}_{}.c3d", st.sentence, st.emotion));
+        let take = replay::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        assert!(matches!(
+            send(&control, SessionControl::Start).await,
+            Reply::Confirm(_)
+        ));
+        if st.take == GAPPY_TAKE && !gappy_done {
+            perform(fp, &take, None, take.n_markers() * 3 / 5, frame).await;
+            let refused = send(&control, SessionControl::Stop).await;
+            let Reply::Error { message, .. } = &refused else {
+                panic!("a take with 60 % of its markers missing was accepted: {refused:?}");
+            };
+            assert!(message.contains("markers"), "{message}");
+            let review = status(&control).await;
+            assert_eq!((review.take, review.state.as_str()), (GAPPY_TAKE, "review"));
+            assert!(matches!(
+                send(&control, SessionControl::Retake).await,
+                Reply::Confirm(_)
+            ));
+            gappy_done = true;
+        }
+        if st.take == KILLED_TAKE && !killed {
+            perform(fp, &take, Some(take.n_frames() / 2), 0, frame).await;
+            // A second for the writer's sync, as a take killed at any moment would have.
+            tokio::time::sleep(Duration::from_millis(1_200)).await;
+            waited += Duration::from_millis(1_200);
+            sigkill(&mut child);
+            killed = true;
+            let listed = replay::session::Session::load(&dir.join("session.toml")).expect("kept");
+            assert_eq!(
+                listed.takes.len(),
+                KILLED_TAKE as usize,
+                "every accepted take kept"
+            );
+            let resumed_at = Instant::now();
+            child = spawn_session(&dir, &synth, fp, cp, true);
+            let again = status(&control).await;
+            waited += resumed_at.elapsed();
+            assert_eq!((again.take, again.state.as_str()), (KILLED_TAKE, "waiting"));
+            assert_eq!((again.sentence, &again.emotion), (st.sentence, &st.emotion));
+            assert!(dir.join("interrupted").read_dir().expect("kept").count() == 1);
+            continue;
+        }
+        perform(fp, &take, None, 0, frame).await;
+        frame += take.n_frames() as i32 + 10;
+        let stopped = send(&control, SessionControl::Stop).await;
+        assert!(
+            matches!(stopped, Reply::Confirm(_)),
+            "take {}: {stopped:?}",
+            st.take
+        );
+    }
+    let recorded = started.elapsed();
+    assert!(gappy_done && killed);
+    let finish_at = Instant::now();
+    assert!(matches!(
+        send(&control, SessionControl::Finish).await,
+        Reply::Confirm(_)
+    ));
+    let status = wait(&mut child, Duration::from_secs(300));
+    assert!(status.success(), "session finished with {status}");
+    let finish = finish_at.elapsed();
+    eprintln!(
+        "issue 33: 32 takes recorded in {:.1} s (of them {:.1} s waits for the kill and the restart), trained and analysed in {:.1} s",
+        recorded.as_secs_f64(),
+        waited.as_secs_f64(),
+        finish.as_secs_f64()
+    );
+    let m = synth.join("session.toml");
+    emoshift(&[
+        "train",
+        "--manifest",
+        m.to_str().expect("utf-8"),
+        "--out",
+        &format!("{s}/model.json"),
+    ]);
+    let report = format!("{s}/report");
+    emoshift(&[
+        "analyze",
+        "--model",
+        &format!("{s}/model.json"),
+        "--manifest",
+        m.to_str().expect("utf-8"),
+        "--out",
+        &report,
+        "--write-model",
+    ]);
+    same_roles_and_space(&trained(&dir), &trained(&synth));
+}
+
+fn wait(child: &mut Child, limit: Duration) -> std::process::ExitStatus {
+    let until = Instant::now() + limit;
+    loop {
+        if let Some(s) = child.try_wait().expect("waits") {
+            return s;
+        }
+        if Instant::now() > until {
+            let _ = child.kill();
+            panic!("the session did not finish within {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+/// The same count of each role, the same emotions, and emotion points in the same order
+/// along each axis.
+fn same_roles_and_space(live: &IcaModel, source: &IcaModel) {
+    let count = |m: &IcaModel| {
+        let mut roles: Vec<String> = m.roles().iter().map(|r| format!("{r:?}")).collect();
+        roles.sort();
+        roles
+    };
+    assert_eq!(count(live), count(source), "roles");
+    for role in ["Emotion", "Speech", "Eyelids"] {
+        assert!(
+            count(live).iter().any(|r| r == role),
+            "no {role} component: {:?}",
+            count(live)
+        );
+    }
+    let (le, se) = (live.emotion(), source.emotion());
+    let mut names = le.names();
+    names.sort();
+    let mut want = se.names();
+    want.sort();
+    assert_eq!(names, want, "emotions");
+    assert_eq!(want.len(), 4, "{want:?}");
+    assert_eq!(le.dims(), se.dims(), "emotion space dimensions");
+    let points = |e: &ica_core::model::EmotionLevels| -> Vec<Vec<f64>> {
+        want.iter().map(|n| e.point(n).expect("a point")).collect()
+    };
+    let (lp, sp) = (points(le), points(se));
+    // Distances between emotions agree (axes may differ in sign or order between fits).
+    for i in 0..want.len() {
+        for j in i + 1..want.len() {
+            let d = |p: &[Vec<f64>]| -> f64 {
+                p[i].iter()
+                    .zip(&p[j])
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            };
+            let (dl, ds) = (d(&lp), d(&sp));
+            assert!(
+                (dl - ds).abs() <= 0.25 * ds.max(0.1),
+                "{} to {}: {dl} vs {ds}",
+                want[i],
+                want[j]
+            );
+        }
+    }
+}
