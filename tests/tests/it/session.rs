@@ -3,14 +3,17 @@
 //! synthetic paired session (sentence k in emotion e), then stops. Along the way a take with
 //! most markers missing is refused and retaken, and the process is killed mid-take and
 //! resumed. The written session then trains and analyses to the same roles and emotion
-//! space as the synthetic session's own manifest.
+//! space as the synthetic session's own manifest. The same through the NatNet source, from
+//! the Motive stand-in.
 
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use daemon::loopback;
+use daemon::loopback::motive::{Motive, MotiveOptions};
 use ica_core::model::IcaModel;
+use protocol::natnet::{FrameOfData, MarkersetDef, ModelDefs, NatNetVersion};
 use protocol::{Control, Labels, Reply, SessionControl, SessionStatus};
 
 use super::support::*;
@@ -32,11 +35,133 @@ fn emoshift(args: &[&str]) {
     );
 }
 
-fn spawn_session(dir: &Path, synth: &Path, listen: u16, control: u16, resume: bool) -> Child {
+/// Where the scripted performer's frames go: an OSC port, or a Motive stand-in.
+enum Feed {
+    Osc(u16),
+    NatNet(Motive),
+}
+
+impl Feed {
+    /// A stand-in streaming one markerset "Face" with `labels`, multicast on loopback.
+    fn natnet(labels: &[String]) -> Feed {
+        let group = format!("239.255.42.99:{}", free_port())
+            .parse()
+            .expect("addr");
+        let defs = ModelDefs {
+            markersets: vec![MarkersetDef {
+                name: "Face".into(),
+                marker_names: labels.to_vec(),
+            }],
+            ..ModelDefs::default()
+        };
+        let motive = Motive::start(MotiveOptions {
+            command: "127.0.0.1:0".parse().expect("addr"),
+            multicast: Some(group),
+            version: NatNetVersion::V3_0,
+            defs,
+            epoch: Instant::now(),
+            rate_hz: 120.0,
+        })
+        .expect("the stand-in binds");
+        Feed::NatNet(motive)
+    }
+
+    fn args(&self) -> Vec<String> {
+        match self {
+            Feed::Osc(port) => vec!["--listen".into(), format!("127.0.0.1:{port}")],
+            Feed::NatNet(m) => vec![
+                "--natnet".into(),
+                m.command_addr().to_string(),
+                "--natnet-names".into(),
+                "marker".into(),
+            ],
+        }
+    }
+
+    /// Until a just-started session is connected (NatNet: the stand-in has a new client and
+    /// time passed for its model definitions).
+    async fn until_connected(&self, clients_before: usize) {
+        let Feed::NatNet(m) = self else { return };
+        for _ in 0..100 {
+            if m.clients() > clients_before {
+                break;
+            }
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+        tokio::time::sleep(Duration::from_millis(500)).await;
+    }
+
+    fn clients(&self) -> usize {
+        match self {
+            Feed::Osc(_) => 0,
+            Feed::NatNet(m) => m.clients(),
+        }
+    }
+
+    /// Sends `frames` frames of `take` (all when `None`), `gone` of its markers missing, frame
+    /// numbers from `first`; a 1 ms pause every 8 frames keeps loopback's buffers from
+    /// filling.
+    async fn perform(
+        &mut self,
+        take: &replay::Take,
+        frames: Option<usize>,
+        gone: usize,
+        first: i32,
+    ) {
+        let m = take.n_markers();
+        let step_us = (1e6 / take.rate_hz) as i64;
+        let mut osc = match self {
+            Feed::Osc(port) => {
+                let labels = Labels {
+                    layout_id: 0,
+                    names: take.labels.clone(),
+                };
+                let addr = format!("127.0.0.1:{port}").parse().expect("addr");
+                Some(loopback::Source::on_loopback(&labels, addr).expect("a loopback source"))
+            }
+            Feed::NatNet(_) => None,
+        };
+        let missing: Vec<bool> = (0..m).map(|k| k < gone).collect();
+        let mut natnet = FrameOfData::default();
+        for f in 0..frames.unwrap_or(take.n_frames()) {
+            let n = first + f as i32;
+            let xyz = &take.positions[f * m * 3..(f + 1) * m * 3];
+            match (&mut osc, &mut *self) {
+                (Some(source), _) => source
+                    .send_frame(n, i64::from(n) * step_us, xyz, &missing)
+                    .expect("finite"),
+                (None, Feed::NatNet(motive)) => {
+                    let metres: Vec<[f32; 3]> = xyz
+                        .chunks_exact(3)
+                        .zip(&missing)
+                        .map(|(c, &gone)| match gone {
+                            true => [f32::NAN; 3],
+                            false => [c[0] / 1e3, c[1] / 1e3, c[2] / 1e3],
+                        })
+                        .collect();
+                    natnet.clear();
+                    natnet.frame_number = n;
+                    natnet.push_markerset("Face", &metres);
+                    natnet.camera_mid_exposure = (i64::from(n) * step_us) as u64;
+                    motive.send(&natnet).expect("encodes");
+                }
+                (None, Feed::Osc(_)) => unreachable!("an OSC feed has its source"),
+            }
+            if f % 8 == 7 {
+                tokio::time::sleep(Duration::from_millis(1)).await;
+            }
+        }
+        // The last datagrams reach the session before the stop does.
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+async fn spawn_session(dir: &Path, synth: &Path, feed: &Feed, control: u16, resume: bool) -> Child {
+    let before = feed.clients();
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"));
     cmd.arg("session")
         .arg(dir)
-        .args(["--listen", &format!("127.0.0.1:{listen}")])
+        .args(feed.args())
         .args(["--control", &format!("127.0.0.1:{control}")])
         .arg("--regions")
         .arg(synth.join("regions.toml"))
@@ -46,7 +171,9 @@ fn spawn_session(dir: &Path, synth: &Path, listen: u16, control: u16, resume: bo
     if resume {
         cmd.arg("--resume");
     }
-    cmd.spawn().expect("the binary starts")
+    let child = cmd.spawn().expect("the binary starts");
+    feed.until_connected(before).await;
+    child
 }
 
 async fn status(control: &ControlClient) -> SessionStatus {
@@ -59,32 +186,6 @@ async fn status(control: &ControlClient) -> SessionStatus {
 
 async fn send(control: &ControlClient, c: SessionControl) -> Reply {
     control.send(&Control::Session(c)).await
-}
-
-/// Sends `frames` frames of `take` (all when `None`), `gone` of its markers missing, frame
-/// numbers from `first`; a 1 ms pause every 8 frames keeps loopback's buffers from filling.
-async fn perform(to: u16, take: &replay::Take, frames: Option<usize>, gone: usize, first: i32) {
-    let labels = Labels {
-        layout_id: 0,
-        names: take.labels.clone(),
-    };
-    let addr = format!("127.0.0.1:{to}").parse().expect("addr");
-    let mut source = loopback::Source::on_loopback(&labels, addr).expect("a loopback source");
-    let m = take.n_markers();
-    let missing: Vec<bool> = (0..m).map(|k| k < gone).collect();
-    let step_us = (1e6 / take.rate_hz) as i64;
-    for f in 0..frames.unwrap_or(take.n_frames()) {
-        let n = first + f as i32;
-        let xyz = &take.positions[f * m * 3..(f + 1) * m * 3];
-        source
-            .send_frame(n, i64::from(n) * step_us, xyz, &missing)
-            .expect("finite");
-        if f % 8 == 7 {
-            tokio::time::sleep(Duration::from_millis(1)).await;
-        }
-    }
-    // The last datagrams reach the session before the stop does.
-    tokio::time::sleep(Duration::from_millis(50)).await;
 }
 
 fn trained(dir: &Path) -> IcaModel {
@@ -104,76 +205,32 @@ fn sigkill(child: &mut Child) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn issue_33_a_scripted_performer_records_a_session_that_trains_like_its_source() {
+    scripted_session(|_| Feed::Osc(free_port())).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn issue_33_the_same_session_through_natnet_from_the_motive_stand_in() {
+    scripted_session(Feed::natnet).await;
+}
+
+/// Writes a synthetic 8 x 4 session, records it through `emoshift session` fed by `feed`
+/// (given the markers' names), and checks what it trains to.
+async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed) {
     let tmp = tempfile::tempdir().expect("temp dir");
     let synth = tmp.path().join("synth");
     let s = synth.to_str().expect("utf-8");
     emoshift(&["synth", "--out", s, "--emotions", "neutral,happy,sad,angry"]);
+    let labels = replay::load(&synth.join("s01_neutral.c3d"))
+        .expect("a take")
+        .labels;
+    let mut feed = feed(&labels);
     let dir = tmp.path().join("perf");
-    let (fp, cp) = (free_port(), free_port());
-    let mut child = spawn_session(&dir, &synth, fp, cp, false);
+    let cp = free_port();
+    let mut child = spawn_session(&dir, &synth, &feed, cp, false).await;
     let control = ControlClient::new(format!("127.0.0.1:{cp}").parse().expect("addr")).await;
-    let (mut frame, mut gappy_done, mut killed) = (0i32, false, false);
-    let (started, mut waited) = (Instant::now(), Duration::ZERO);
-    loop {
-        let st = status(&control).await;
-        if st.state == "done" {
-            break;
-        }
-        assert_eq!(st.state, "waiting", "{st:?}");
-        let file = synth.join(format!("s{:02}_{}.c3d", st.sentence, st.emotion));
-        let take = replay::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
-        assert!(matches!(
-            send(&control, SessionControl::Start).await,
-            Reply::Confirm(_)
-        ));
-        if st.take == GAPPY_TAKE && !gappy_done {
-            perform(fp, &take, None, take.n_markers() * 3 / 5, frame).await;
-            let refused = send(&control, SessionControl::Stop).await;
-            let Reply::Error { message, .. } = &refused else {
-                panic!("a take with 60 % of its markers missing was accepted: {refused:?}");
-            };
-            assert!(message.contains("markers"), "{message}");
-            let review = status(&control).await;
-            assert_eq!((review.take, review.state.as_str()), (GAPPY_TAKE, "review"));
-            assert!(matches!(
-                send(&control, SessionControl::Retake).await,
-                Reply::Confirm(_)
-            ));
-            gappy_done = true;
-        }
-        if st.take == KILLED_TAKE && !killed {
-            perform(fp, &take, Some(take.n_frames() / 2), 0, frame).await;
-            // A second for the writer's sync, as a take killed at any moment would have.
-            tokio::time::sleep(Duration::from_millis(1_200)).await;
-            waited += Duration::from_millis(1_200);
-            sigkill(&mut child);
-            killed = true;
-            let listed = replay::session::Session::load(&dir.join("session.toml")).expect("kept");
-            assert_eq!(
-                listed.takes.len(),
-                KILLED_TAKE as usize,
-                "every accepted take kept"
-            );
-            let resumed_at = Instant::now();
-            child = spawn_session(&dir, &synth, fp, cp, true);
-            let again = status(&control).await;
-            waited += resumed_at.elapsed();
-            assert_eq!((again.take, again.state.as_str()), (KILLED_TAKE, "waiting"));
-            assert_eq!((again.sentence, &again.emotion), (st.sentence, &st.emotion));
-            assert!(dir.join("interrupted").read_dir().expect("kept").count() == 1);
-            continue;
-        }
-        perform(fp, &take, None, 0, frame).await;
-        frame += take.n_frames() as i32 + 10;
-        let stopped = send(&control, SessionControl::Stop).await;
-        assert!(
-            matches!(stopped, Reply::Confirm(_)),
-            "take {}: {stopped:?}",
-            st.take
-        );
-    }
+    let started = Instant::now();
+    let waited = performer(&mut feed, &control, &synth, &dir, &mut child, cp).await;
     let recorded = started.elapsed();
-    assert!(gappy_done && killed);
     let finish_at = Instant::now();
     assert!(matches!(
         send(&control, SessionControl::Finish).await,
@@ -189,25 +246,110 @@ async fn issue_33_a_scripted_performer_records_a_session_that_trains_like_its_so
         finish.as_secs_f64()
     );
     let m = synth.join("session.toml");
-    emoshift(&[
-        "train",
-        "--manifest",
-        m.to_str().expect("utf-8"),
-        "--out",
-        &format!("{s}/model.json"),
-    ]);
+    let (m, model) = (m.to_str().expect("utf-8"), format!("{s}/model.json"));
+    emoshift(&["train", "--manifest", m, "--out", &model]);
     let report = format!("{s}/report");
     emoshift(&[
         "analyze",
         "--model",
-        &format!("{s}/model.json"),
+        &model,
         "--manifest",
-        m.to_str().expect("utf-8"),
+        m,
         "--out",
         &report,
         "--write-model",
     ]);
     same_roles_and_space(&trained(&dir), &trained(&synth));
+    if let Feed::NatNet(motive) = feed {
+        motive.stop();
+    }
+}
+
+/// Plays every prompted take until the session is done, refusing one with most markers
+/// missing and killing the process in another; returns the time spent waiting for the kill
+/// and the restart.
+async fn performer(
+    feed: &mut Feed,
+    control: &ControlClient,
+    synth: &Path,
+    dir: &Path,
+    child: &mut Child,
+    cp: u16,
+) -> Duration {
+    let (mut frame, mut gappy_done, mut killed) = (0i32, false, false);
+    let mut waited = Duration::ZERO;
+    loop {
+        let st = status(control).await;
+        if st.state == "done" {
+            break;
+        }
+        assert_eq!(st.state, "waiting", "{st:?}");
+        let file = synth.join(format!("s{:02}_{}.c3d", st.sentence, st.emotion));
+        let take = replay::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        assert!(matches!(
+            send(control, SessionControl::Start).await,
+            Reply::Confirm(_)
+        ));
+        if st.take == GAPPY_TAKE && !gappy_done {
+            feed.perform(&take, None, take.n_markers() * 3 / 5, frame)
+                .await;
+            frame += take.n_frames() as i32 + 10;
+            let refused = send(control, SessionControl::Stop).await;
+            let Reply::Error { message, .. } = &refused else {
+                panic!("a take with 60 % of its markers missing was accepted: {refused:?}");
+            };
+            assert!(message.contains("markers"), "{message}");
+            let review = status(control).await;
+            assert_eq!((review.take, review.state.as_str()), (GAPPY_TAKE, "review"));
+            assert!(matches!(
+                send(control, SessionControl::Retake).await,
+                Reply::Confirm(_)
+            ));
+            gappy_done = true;
+        }
+        if st.take == KILLED_TAKE && !killed {
+            feed.perform(&take, Some(take.n_frames() / 2), 0, frame)
+                .await;
+            frame += take.n_frames() as i32 + 10;
+            let t = Instant::now();
+            // A second for the writer's sync, as a take killed at any moment would have.
+            tokio::time::sleep(Duration::from_millis(1_200)).await;
+            sigkill(child);
+            killed = true;
+            let listed = replay::session::Session::load(&dir.join("session.toml")).expect("kept");
+            assert_eq!(
+                listed.takes.len(),
+                KILLED_TAKE as usize,
+                "every accepted take kept"
+            );
+            *child = spawn_session(dir, synth, feed, cp, true).await;
+            let again = status(control).await;
+            waited += t.elapsed();
+            assert_eq!((again.take, again.state.as_str()), (KILLED_TAKE, "waiting"));
+            assert_eq!((again.sentence, &again.emotion), (st.sentence, &st.emotion));
+            let kept = replay::load(&dir.join(format!(
+                "interrupted/s{:02}_{}.c3d",
+                st.sentence, st.emotion
+            )));
+            let kept = kept.expect("the interrupted take is kept and reads");
+            assert!(
+                kept.n_frames() >= take.n_frames() / 2 - 120,
+                "{} frames",
+                kept.n_frames()
+            );
+            continue;
+        }
+        feed.perform(&take, None, 0, frame).await;
+        frame += take.n_frames() as i32 + 10;
+        let stopped = send(control, SessionControl::Stop).await;
+        assert!(
+            matches!(stopped, Reply::Confirm(_)),
+            "take {}: {stopped:?}",
+            st.take
+        );
+    }
+    assert!(gappy_done && killed);
+    waited
 }
 
 fn wait(child: &mut Child, limit: Duration) -> std::process::ExitStatus {
