@@ -202,6 +202,15 @@ pub struct SessionArgs {
     /// Continue the session in DIR where it stopped (Ctrl-C, a crash, a power cut).
     #[arg(long)]
     pub resume: bool,
+    /// With --resume: record these takes again (comma separated, e.g. s03_happy,s05_sad, as
+    /// finish advises); each accepted take they replace moves to DIR/replaced/.
+    #[arg(
+        long,
+        value_name = "TAKE,...",
+        value_delimiter = ',',
+        requires = "resume"
+    )]
+    pub redo: Vec<String>,
     /// The regions file training and analysis use (copied into DIR as regions.toml).
     #[arg(long, value_name = "FILE")]
     pub regions: Option<PathBuf>,

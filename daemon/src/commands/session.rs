@@ -11,6 +11,7 @@ use tokio_util::sync::CancellationToken;
 
 use crate::cli::SessionArgs;
 use crate::exit::UsageError;
+use crate::offline::session::advice::{advise, Advice};
 use crate::offline::session::script::{Script, DEFAULT_SENTENCES};
 use crate::offline::session::Sitting;
 use crate::serve::allow::AllowList;
@@ -140,7 +141,7 @@ pub(crate) fn run(args: &SessionArgs) -> Result<()> {
     if ended == Ended::Interrupted {
         return Ok(());
     }
-    let model = finish(&args.dir)?;
+    let model = finish(args)?;
     if let Some(to) = &args.load_into {
         runtime.block_on(load_into(to, &model))?;
     }
@@ -149,7 +150,8 @@ pub(crate) fn run(args: &SessionArgs) -> Result<()> {
 
 /// Trains on the accepted takes into `DIR/model.json` (an older one goes to `replaced/`) and
 /// analyses them into `DIR/report/` when the session has a regions file.
-fn finish(dir: &Path) -> Result<PathBuf> {
+fn finish(args: &SessionArgs) -> Result<PathBuf> {
+    let dir = args.dir.as_path();
     let manifest = dir.join(MANIFEST);
     let session = crate::offline::load_session(&manifest)?;
     let model_path = dir.join("model.json");
@@ -180,8 +182,39 @@ fn finish(dir: &Path) -> Result<PathBuf> {
         write_model: true,
         axes: crate::offline::analysis::Axes::default(),
     };
-    super::analyze::analyze_and_write(&model_path, &manifest, None, &report)?;
+    let (_, report) = super::analyze::analyze_and_write(&model_path, &manifest, None, &report)?;
+    tell_advice(args, &advise(&report))?;
     Ok(model_path)
+}
+
+/// What to redo, and the command that records just those takes again.
+fn tell_advice(args: &SessionArgs, advice: &Advice) -> Result<()> {
+    if advice.lines.is_empty() {
+        crate::out!("nothing to redo: every emotion stands apart and no take is an outlier");
+        return Ok(());
+    }
+    crate::out!("to redo:");
+    for line in &advice.lines {
+        crate::out!("  - {line}");
+    }
+    if !advice.redo.is_empty() {
+        let source = match (&args.listen, &args.natnet) {
+            (Some(l), _) => format!("--listen {l}"),
+            (_, Some(n)) => format!("--natnet {n}"),
+            _ => String::new(),
+        };
+        let takes: Vec<&str> = advice
+            .redo
+            .iter()
+            .map(|f| f.trim_end_matches(&format!(".{}", args.format)))
+            .collect();
+        crate::out!(
+            "re-record just those takes, then finish again: emoshift session {} {source} --resume --redo {}",
+            args.dir.display(),
+            takes.join(",")
+        );
+    }
+    Ok(())
 }
 
 /// `/model/load` of the model to a running serve's control socket, and its answer.

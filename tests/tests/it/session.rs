@@ -166,7 +166,7 @@ async fn spawn_session(dir: &Path, synth: &Path, feed: &Feed, control: u16, resu
         .arg("--regions")
         .arg(synth.join("regions.toml"))
         .arg("--no-keyboard")
-        .stdout(Stdio::null())
+        .stdout(log(dir))
         .stderr(Stdio::inherit());
     if resume {
         cmd.arg("--resume");
@@ -174,6 +174,15 @@ async fn spawn_session(dir: &Path, synth: &Path, feed: &Feed, control: u16, resu
     let child = cmd.spawn().expect("the binary starts");
     feed.until_connected(before).await;
     child
+}
+
+/// The session's terminal, appended to `<dir>.log`.
+fn log(dir: &Path) -> std::fs::File {
+    std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(dir.with_extension("log"))
+        .expect("a log file")
 }
 
 async fn status(control: &ControlClient) -> SessionStatus {
@@ -260,6 +269,10 @@ async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed) {
         "--write-model",
     ]);
     same_roles_and_space(&trained(&dir), &trained(&synth));
+    let said = std::fs::read_to_string(dir.with_extension("log")).expect("the session's log");
+    for line in ["REFUSED: only", "kept as", "nothing to redo", "roles and levels written"] {
+        assert!(said.contains(line), "the session never said {line:?}:\n{said}");
+    }
     if let Feed::NatNet(motive) = feed {
         motive.stop();
     }

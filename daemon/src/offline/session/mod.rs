@@ -7,6 +7,7 @@
 //! with [`Sitting::handle_checked`]. [`Sitting::manifest`] is the `session.toml` of what was
 //! accepted, written after every accepted take.
 
+pub mod advice;
 pub mod check;
 pub mod script;
 
@@ -102,6 +103,33 @@ impl Sitting {
         s.last_accepted = (0..s.plan.len()).rev().find(|&i| s.accepted[i]);
         s.move_on();
         s
+    }
+
+    /// Offers the takes named (`s03_happy.c3d` or `s03_happy`) again: each stays on disk and
+    /// in the manifest's folder until its new take is accepted, and then moves to
+    /// `replaced/`.
+    ///
+    /// # Errors
+    /// A name that is no take of the script.
+    pub fn redo(&mut self, names: &[String]) -> Result<(), String> {
+        for name in names {
+            let file = match name.ends_with(&format!(".{}", self.ext)) {
+                true => name.clone(),
+                false => format!("{name}.{}", self.ext),
+            };
+            let Some(i) = self
+                .plan
+                .iter()
+                .position(|p| p.file_name(&self.ext) == file)
+            else {
+                return Err(format!("--redo {name}: no such take in the script"));
+            };
+            self.accepted[i] = false;
+        }
+        self.cursor = 0;
+        self.state = State::Waiting;
+        self.move_on();
+        Ok(())
     }
 
     /// The script.

@@ -64,3 +64,19 @@ fn a_skipped_take_comes_back_at_the_end_and_resume_continues_where_it_stopped() 
         Ok(Step::Record { replaces: true, .. })
     ));
 }
+
+#[test]
+fn redo_offers_named_takes_again_and_refuses_unknown_names() {
+    let mut s = sitting();
+    for _ in 0..8 {
+        s.handle(C::Start).expect("start");
+        s.handle(C::Stop).expect("stop");
+        s.handle_checked(Ok(120.0));
+    }
+    assert_eq!(s.status().state, "done");
+    s.redo(&["s02_sad".into(), "s01_happy.c3d".into()]).expect("known takes");
+    assert_eq!((s.accepted(), s.status().state.as_str()), (6, "waiting"));
+    assert_eq!(s.prompt().file_name("c3d"), "s01_happy.c3d");
+    assert!(matches!(s.handle(C::Start), Ok(Step::Record { replaces: false, .. })));
+    assert!(s.redo(&["s09_sad".into()]).is_err());
+}
