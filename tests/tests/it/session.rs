@@ -38,7 +38,7 @@ fn emoshift(args: &[&str]) {
 /// Where the scripted performer's frames go: an OSC port, or a Motive stand-in.
 enum Feed {
     Osc(u16),
-    NatNet(Motive),
+    NatNet(Box<Motive>),
 }
 
 impl Feed {
@@ -63,7 +63,7 @@ impl Feed {
             rate_hz: 120.0,
         })
         .expect("the stand-in binds");
-        Feed::NatNet(motive)
+        Feed::NatNet(Box::new(motive))
     }
 
     fn args(&self) -> Vec<String> {
