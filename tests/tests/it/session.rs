@@ -270,8 +270,16 @@ async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed) {
     ]);
     same_roles_and_space(&trained(&dir), &trained(&synth));
     let said = std::fs::read_to_string(dir.with_extension("log")).expect("the session's log");
-    for line in ["REFUSED: only", "kept as", "nothing to redo", "roles and levels written"] {
-        assert!(said.contains(line), "the session never said {line:?}:\n{said}");
+    for line in [
+        "REFUSED: only",
+        "kept as",
+        "nothing to redo",
+        "roles and levels written",
+    ] {
+        assert!(
+            said.contains(line),
+            "the session never said {line:?}:\n{said}"
+        );
     }
     if let Feed::NatNet(motive) = feed {
         motive.stop();

@@ -74,9 +74,16 @@ fn redo_offers_named_takes_again_and_refuses_unknown_names() {
         s.handle_checked(Ok(120.0));
     }
     assert_eq!(s.status().state, "done");
-    s.redo(&["s02_sad".into(), "s01_happy.c3d".into()]).expect("known takes");
+    s.redo(&["s02_sad".into(), "s01_happy.c3d".into()])
+        .expect("known takes");
     assert_eq!((s.accepted(), s.status().state.as_str()), (6, "waiting"));
     assert_eq!(s.prompt().file_name("c3d"), "s01_happy.c3d");
-    assert!(matches!(s.handle(C::Start), Ok(Step::Record { replaces: false, .. })));
+    assert!(matches!(
+        s.handle(C::Start),
+        Ok(Step::Record {
+            replaces: false,
+            ..
+        })
+    ));
     assert!(s.redo(&["s09_sad".into()]).is_err());
 }
