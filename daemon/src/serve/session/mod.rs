@@ -1,7 +1,7 @@
 //! `emoshift session`'s live half: the source runs for the whole session (the same as
 //! `record`'s, [`super::capture::listen`]); each take is a [`Take`] the frames go into while it
 //! records, checked the moment it stops ([`crate::offline::session::check`]); controls come
-//! from the keyboard and from an OSC control socket under serve's rules ([`Guard`]: loopback
+//! from the keyboard and from an OSC control socket under serve's rules (its `Guard`: loopback
 //! by default, then the allow-list and the secret), and go through one [`Sitting`].
 
 pub mod files;
