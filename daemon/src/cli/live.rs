@@ -227,6 +227,11 @@ pub struct SessionArgs {
     /// Do not read controls from the keyboard (stdin).
     #[arg(long)]
     pub no_keyboard: bool,
+    /// Serve the performer's view (the sentence large, the emotion, take n of N, a recording
+    /// light, the markers seen) at this address [default: 127.0.0.1:9080].
+    #[arg(long, value_name = "IP:PORT", num_args = 0..=1,
+          default_missing_value = crate::serve::session::view::DEFAULT_VIEW)]
+    pub monitor: Option<String>,
 }
 
 /// `emoshift replay`.

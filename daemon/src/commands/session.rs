@@ -54,6 +54,14 @@ fn config(args: &SessionArgs) -> Result<SessionConfig> {
         control_secret: args.control_secret.clone(),
         min_seen: args.min_seen,
         keyboard: !args.no_keyboard,
+        monitor: args
+            .monitor
+            .as_ref()
+            .map(|m| {
+                m.parse()
+                    .map_err(|_| UsageError(format!("--monitor: {m:?} is not an IP:PORT address")))
+            })
+            .transpose()?,
     })
 }
 

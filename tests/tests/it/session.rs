@@ -156,7 +156,15 @@ impl Feed {
     }
 }
 
-async fn spawn_session(dir: &Path, synth: &Path, feed: &Feed, control: u16, resume: bool) -> Child {
+/// The session's control port, and its performer view's.
+#[derive(Clone, Copy)]
+struct Ports {
+    control: u16,
+    view: u16,
+}
+
+async fn spawn_session(dir: &Path, synth: &Path, feed: &Feed, ports: Ports, resume: bool) -> Child {
+    let control = ports.control;
     let before = feed.clients();
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"));
     cmd.arg("session")
@@ -166,6 +174,7 @@ async fn spawn_session(dir: &Path, synth: &Path, feed: &Feed, control: u16, resu
         .arg("--regions")
         .arg(synth.join("regions.toml"))
         .arg("--no-keyboard")
+        .args(["--monitor", &format!("127.0.0.1:{}", ports.view)])
         .stdout(log(dir))
         .stderr(Stdio::inherit());
     if resume {
@@ -195,6 +204,26 @@ async fn status(control: &ControlClient) -> SessionStatus {
 
 async fn send(control: &ControlClient, c: SessionControl) -> Reply {
     control.send(&Control::Session(c)).await
+}
+
+/// The performer view's `/session.json` (and its page holds the view's fields).
+fn view(port: u16) -> serde_json::Value {
+    let get = |path: &str| {
+        use std::io::{Read, Write};
+        let mut c = std::net::TcpStream::connect(("127.0.0.1", port)).expect("the view is up");
+        write!(c, "GET {path} HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n").expect("sent");
+        let mut text = String::new();
+        c.read_to_string(&mut text).expect("an answer");
+        text.split_once("\r\n\r\n")
+            .map(|(_, b)| b.to_string())
+            .expect("a body")
+    };
+    let page = get("/");
+    assert!(
+        page.contains("id=\"emotion\"") && page.contains("id=\"light\""),
+        "{page}"
+    );
+    serde_json::from_str(&get("/session.json")).expect("json")
 }
 
 fn trained(dir: &Path) -> IcaModel {
@@ -234,9 +263,13 @@ async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed) {
         .labels;
     let mut feed = feed(&labels);
     let dir = tmp.path().join("perf");
-    let cp = free_port();
+    let cp = Ports {
+        control: free_port(),
+        view: free_port(),
+    };
     let mut child = spawn_session(&dir, &synth, &feed, cp, false).await;
-    let control = ControlClient::new(format!("127.0.0.1:{cp}").parse().expect("addr")).await;
+    let control =
+        ControlClient::new(format!("127.0.0.1:{}", cp.control).parse().expect("addr")).await;
     let started = Instant::now();
     let waited = performer(&mut feed, &control, &synth, &dir, &mut child, cp).await;
     let recorded = started.elapsed();
@@ -295,7 +328,7 @@ async fn performer(
     synth: &Path,
     dir: &Path,
     child: &mut Child,
-    cp: u16,
+    cp: Ports,
 ) -> Duration {
     let (mut frame, mut gappy_done, mut killed) = (0i32, false, false);
     let mut waited = Duration::ZERO;
@@ -303,6 +336,16 @@ async fn performer(
         let st = status(control).await;
         if st.state == "done" {
             break;
+        }
+        if st.take <= 1 {
+            // The performer's page shows the prompt, and the next one once a take is in.
+            let v = view(cp.view);
+            assert_eq!(v["take"], st.take + 1, "{v}");
+            assert_eq!(
+                (v["text"].as_str(), v["emotion"].as_str()),
+                (Some(st.text.as_str()), Some(st.emotion.as_str()))
+            );
+            assert_eq!(v["state"], "waiting");
         }
         assert_eq!(st.state, "waiting", "{st:?}");
         let file = synth.join(format!("s{:02}_{}.c3d", st.sentence, st.emotion));

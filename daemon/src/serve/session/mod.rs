@@ -6,6 +6,8 @@
 
 pub mod files;
 mod keys;
+mod osc;
+pub mod view;
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
@@ -25,6 +27,7 @@ use super::guard::Guard;
 use super::sources::Arrival;
 use crate::offline::session::check::{self, Expect};
 use crate::offline::session::{Sitting, State, Step};
+use view::View;
 
 /// What the session needs besides its [`Sitting`].
 #[derive(Debug, Clone)]
@@ -45,6 +48,8 @@ pub struct SessionConfig {
     pub min_seen: f64,
     /// Read controls from the keyboard (stdin).
     pub keyboard: bool,
+    /// Serve the performer's view here.
+    pub monitor: Option<SocketAddr>,
 }
 
 /// How the session ended.
@@ -83,18 +88,32 @@ pub async fn run(
     let quiet = Mutex::new(Quiet::default());
     let stop = shutdown.child_token();
     let (tx, mut rx) = mpsc::channel::<Request>(16);
-    let control = match config.control {
-        Some(addr) => Some(Arc::new(UdpSocket::bind(addr).await.with_context(
-            || format!("binding the session's control socket {addr} (is another program on it?)"),
-        )?)),
-        None => None,
-    };
+    let control = bind_control(config.control).await?;
     if config.keyboard {
         keys::spawn(tx.clone());
     }
+    let view = Arc::new(Mutex::new(View::default()));
+    lock(&view).update(sitting);
+    if let Some(addr) = config.monitor {
+        let listener = tokio::net::TcpListener::bind(addr).await.with_context(|| {
+            format!("binding the performer view {addr} (is another program on it?)")
+        })?;
+        say(&format!(
+            "performer view: http://{}/",
+            listener.local_addr()?
+        ));
+        tokio::spawn(view::serve(listener, view.clone(), stop.clone()));
+    }
     let guard = Guard::with_rules(config.control_allow.clone(), config.control_secret.clone());
+    let watch = config.monitor.is_some();
     let mut sink = |frame: &SourceFrame<'_>, arrival: &Arrival| {
         lock(&quiet).heard(arrival.received);
+        if watch {
+            let n = frame.labels.len();
+            let seen = (0..n).filter(|&i| !frame.frame.is_missing(i)).count();
+            let mut v = lock(&view);
+            (v.markers_seen, v.markers) = (seen, n);
+        }
         let mut l = lock(&live);
         let Live { take, error } = &mut *l;
         if let (Some(t), None) = (take.as_mut(), &error) {
@@ -107,24 +126,33 @@ pub async fn run(
     let mut notice = |line: &str| tracing::warn!(target: "emoshift", "{line}");
     tell_prompt(sitting, say);
     let main = async {
-        let r = steps(config, sitting, &live, &mut rx, &stop, say).await;
+        let r = steps(config, sitting, (&live, &view), &mut rx, &stop, say).await;
         stop.cancel();
         r
     };
     let (listened, ended, ()) = tokio::join!(
         capture::listen(&config.source, &quiet, &stop, &mut sink, &mut notice),
         main,
-        control_task(control, &guard, tx, &stop),
+        osc::control_task(control, &guard, tx, &stop),
     );
     listened?;
     ended
+}
+
+/// The OSC control socket, when one is asked for.
+async fn bind_control(addr: Option<SocketAddr>) -> Result<Option<Arc<UdpSocket>>> {
+    let Some(addr) = addr else { return Ok(None) };
+    let socket = UdpSocket::bind(addr).await.with_context(|| {
+        format!("binding the session's control socket {addr} (is another program on it?)")
+    })?;
+    Ok(Some(Arc::new(socket)))
 }
 
 /// The controls, one at a time, until finish or `stop`.
 async fn steps(
     config: &SessionConfig,
     sitting: &mut Sitting,
-    live: &Mutex<Live>,
+    (live, view): (&Mutex<Live>, &Mutex<View>),
     rx: &mut mpsc::Receiver<Request>,
     stop: &CancellationToken,
     say: &mut (dyn FnMut(&str) + Send),
@@ -165,6 +193,7 @@ async fn steps(
                 protocol::encode_error_into(control.address(), why, &mut out)
             }
         };
+        lock(view).update(sitting);
         if let Some(reply) = request.reply {
             let _ = reply.send(out);
         }
@@ -331,54 +360,6 @@ fn tell_prompt(sitting: &Sitting, say: &mut (dyn FnMut(&str) + Send)) {
             p.sentence + 1,
             p.emotion.to_uppercase()
         )),
-    }
-}
-
-/// The OSC control socket: admitted session controls to the session, answered with its reply;
-/// anything else refused the way serve refuses it.
-async fn control_task(
-    socket: Option<Arc<UdpSocket>>,
-    guard: &Guard,
-    tx: mpsc::Sender<Request>,
-    stop: &CancellationToken,
-) {
-    let Some(socket) = socket else { return };
-    let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
-    loop {
-        let (len, peer) = tokio::select! {
-            () = stop.cancelled() => return,
-            r = socket.recv_from(&mut buf) => match r {
-                Ok(r) => r,
-                Err(_) => continue,
-            },
-        };
-        let admitted = guard.admit(peer).and_then(|()| guard.decode(&buf[..len]));
-        let mut out = Vec::with_capacity(256);
-        match admitted {
-            Ok(Control::Session(control)) => {
-                let (reply, answer) = oneshot::channel();
-                let request = Request {
-                    control,
-                    reply: Some(reply),
-                };
-                if tx.send(request).await.is_err() {
-                    return;
-                }
-                match answer.await {
-                    Ok(bytes) => out = bytes,
-                    Err(_) => return,
-                }
-            }
-            Ok(other) => {
-                let why = "a calibration session takes /session/* controls only";
-                protocol::encode_error_into(other.address(), why, &mut out);
-            }
-            Err(refusal) => {
-                guard.warn_refused(peer, "", &refusal);
-                protocol::encode_error_into("", &refusal.to_string(), &mut out);
-            }
-        }
-        let _ = socket.send_to(&out, peer).await;
     }
 }
 
