@@ -53,6 +53,23 @@ pub const RECORD_START: &str = "/record/start";
 pub const RECORD_STOP: &str = "/record/stop";
 /// Control: ask for the counters, no arguments; answered by `/status/confirm`.
 pub const STATUS: &str = "/status";
+/// Session control (`emoshift session`): record the prompted take, no arguments.
+pub const SESSION_START: &str = "/session/start";
+/// Session control: stop the take being recorded and check it, no arguments.
+pub const SESSION_STOP: &str = "/session/stop";
+/// Session control: record the prompted take again (after a refusal), or the last accepted
+/// one again, no arguments.
+pub const SESSION_RETAKE: &str = "/session/retake";
+/// Session control: leave the prompted take out and go on, no arguments.
+pub const SESSION_SKIP: &str = "/session/skip";
+/// Session control: go back to the take before the prompted one, no arguments.
+pub const SESSION_BACK: &str = "/session/back";
+/// Session control: train and analyse what was recorded, no arguments.
+pub const SESSION_FINISH: &str = "/session/finish";
+/// Session control: ask where the session is, no arguments; answered by
+/// `/session/status/confirm ,iiisss` (take index from 0, takes in total, sentence number from
+/// 1, emotion, state, sentence text).
+pub const SESSION_STATUS: &str = "/session/status";
 
 /// Every address this crate knows, for routing a [`crate::Message`] without string compares
 /// scattered through the caller.
@@ -86,7 +103,7 @@ pub enum Address {
     Confirm,
 }
 
-const CONTROLS: [&str; 14] = [
+const CONTROLS: [&str; 21] = [
     EMOTION_TARGET,
     EMOTION_AMOUNT,
     EMOTION_RAMP,
@@ -101,6 +118,13 @@ const CONTROLS: [&str; 14] = [
     RECORD_START,
     RECORD_STOP,
     STATUS,
+    SESSION_START,
+    SESSION_STOP,
+    SESSION_RETAKE,
+    SESSION_SKIP,
+    SESSION_BACK,
+    SESSION_FINISH,
+    SESSION_STATUS,
 ];
 
 impl Address {

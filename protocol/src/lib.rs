@@ -77,8 +77,8 @@ mod wire;
 
 pub use address::Address;
 pub use control::{
-    decode_control, decode_control_with_secret, Control, ControlError, Profile, MAX_ALPHA,
-    MAX_GAIN, MAX_MIX_WEIGHT, MAX_NAME_BYTES, MAX_PATH_BYTES, MAX_RAMP_S,
+    decode_control, decode_control_with_secret, Control, ControlError, Profile, SessionControl,
+    MAX_ALPHA, MAX_GAIN, MAX_MIX_WEIGHT, MAX_NAME_BYTES, MAX_PATH_BYTES, MAX_RAMP_S,
 };
 pub use error::{DecodeError, DecodeErrorKind, EncodeError};
 pub use frame::{
@@ -95,8 +95,8 @@ pub use output::{
 };
 pub use reply::{
     decode_reply, encode_challenge_into, encode_confirm_into, encode_control_into,
-    encode_control_signed_into, encode_emotion_list_into, encode_error_into, encode_status_into,
-    EmotionList, Reply, StatusValue,
+    encode_control_signed_into, encode_emotion_list_into, encode_error_into,
+    encode_session_status_into, encode_status_into, EmotionList, Reply, SessionStatus, StatusValue,
 };
 pub use scan::{
     check_datagram, messages, Limits, Message, Messages, TimeTag, BUNDLE_DEPTH_CAP,

@@ -33,6 +33,8 @@ pub enum Reply {
     Status(Vec<(String, StatusValue)>),
     /// `/subscribe/challenge ,i`: echo this cookie in the `/subscribe` to be subscribed.
     Challenge(i32),
+    /// `/session/status/confirm ,iiisss`: where a calibration session is.
+    SessionStatus(SessionStatus),
     /// `/emoshift/error ,ss`.
     Error {
         /// Address of the refused message.
@@ -40,6 +42,24 @@ pub enum Reply {
         /// Why it was refused.
         message: String,
     },
+}
+
+/// Where a calibration session (`emoshift session`) is, as `/session/status/confirm ,iiisss`
+/// carries it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SessionStatus {
+    /// The prompted take, from 0 (equal to `takes` when every take is done).
+    pub take: i32,
+    /// Takes in the script.
+    pub takes: i32,
+    /// The prompted sentence's number in the script, from 1.
+    pub sentence: i32,
+    /// The prompted emotion.
+    pub emotion: String,
+    /// `waiting`, `recording`, `review` or `done`.
+    pub state: String,
+    /// The sentence's text.
+    pub text: String,
 }
 
 /// One value of `/status/confirm`.
@@ -150,6 +170,23 @@ pub fn encode_status_into<S: AsRef<str>>(pairs: &[(S, StatusValue)], out: &mut V
     encode_message(format!("{}{}", a::STATUS, a::CONFIRM_SUFFIX), args, out)
 }
 
+/// Encodes `/session/status/confirm ,iiisss`. Returns the length.
+pub fn encode_session_status_into(status: &SessionStatus, out: &mut Vec<u8>) -> usize {
+    let args = vec![
+        OscType::Int(status.take),
+        OscType::Int(status.takes),
+        OscType::Int(status.sentence),
+        OscType::String(osc_string(&status.emotion)),
+        OscType::String(osc_string(&status.state)),
+        OscType::String(osc_string(&status.text)),
+    ];
+    encode_message(
+        format!("{}{}", a::SESSION_STATUS, a::CONFIRM_SUFFIX),
+        args,
+        out,
+    )
+}
+
 /// Encodes `/emotion/list/confirm`: `i` the number of emotion components `k`, `k` × `i` their
 /// indices, then for each emotion its name (`s`) and `k` × `f` levels. Returns the length.
 pub fn encode_emotion_list_into(list: &EmotionList, out: &mut Vec<u8>) -> usize {
@@ -203,6 +240,21 @@ pub fn decode_reply(msg: &[u8]) -> Result<Reply, ControlError> {
     };
     if base == a::STATUS {
         return parse_status(m.args).map(Reply::Status);
+    }
+    if base == a::SESSION_STATUS {
+        return match <[OscType; 6]>::try_from(m.args) {
+            Ok(
+                [OscType::Int(take), OscType::Int(takes), OscType::Int(sentence), OscType::String(emotion), OscType::String(state), OscType::String(text)],
+            ) => Ok(Reply::SessionStatus(SessionStatus {
+                take,
+                takes,
+                sentence,
+                emotion,
+                state,
+                text,
+            })),
+            _ => Err(DecodeError::WrongTypeTags.into()),
+        };
     }
     if base == a::EMOTION_LIST {
         return parse_emotion_list(m.args)

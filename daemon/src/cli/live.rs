@@ -180,6 +180,76 @@ pub struct RecordArgs {
     pub performer: Option<String>,
 }
 
+/// `emoshift session`.
+#[derive(Debug, Args)]
+pub struct SessionArgs {
+    /// The session folder: takes, session.toml, script.toml, then model.json and report/.
+    pub dir: PathBuf,
+    /// Take OSC frames on this socket, IP:PORT (what `emoshift replay --to` or a stage bridge
+    /// sends to).
+    #[arg(long, value_name = "IP:PORT", conflicts_with = "natnet")]
+    pub listen: Option<String>,
+    /// Take frames from a NatNet server (OptiTrack Motive): its command channel, IP[:PORT].
+    #[arg(long, value_name = "SERVER[:PORT]")]
+    pub natnet: Option<String>,
+    /// The NatNet source's settings.
+    #[command(flatten)]
+    pub natnet_options: NatNetArgs,
+    /// Take frames from Qualisys QTM's real-time output: HOST[:PORT] [port 22223].
+    #[arg(long, value_name = "HOST[:PORT]")]
+    pub qtm: Option<String>,
+    /// The script (TOML: `emotions = [...]` and [[sentence]] tables with `text`) [default: the
+    /// Harvard sentences in neutral, happy, sad and angry].
+    #[arg(long, value_name = "FILE", conflicts_with = "resume")]
+    pub script: Option<PathBuf>,
+    /// The stream to record: a NatNet markerset (asset) name, or `IP:PORT/LAYOUT` of an OSC
+    /// source [default: the first stream that arrives].
+    #[arg(long, value_name = "NAME")]
+    pub performer: Option<String>,
+    /// Take /session/* controls on this OSC socket, IP:PORT.
+    #[arg(long, value_name = "IP:PORT")]
+    pub control: Option<String>,
+    /// Who may control, networks in CIDR form, comma separated [default: loopback only].
+    #[arg(long, value_name = "CIDR,...", value_delimiter = ',')]
+    pub control_allow: Vec<String>,
+    /// The shared secret mutating controls carry as their last argument.
+    #[arg(long, env = "EMOSHIFT_CONTROL_SECRET", hide_env_values = true)]
+    pub control_secret: Option<String>,
+    /// Continue the session in DIR where it stopped (Ctrl-C, a crash, a power cut).
+    #[arg(long)]
+    pub resume: bool,
+    /// With --resume: record these takes again (comma separated, e.g. s03_happy,s05_sad, as
+    /// finish advises); each accepted take they replace moves to DIR/replaced/.
+    #[arg(
+        long,
+        value_name = "TAKE,...",
+        value_delimiter = ',',
+        requires = "resume"
+    )]
+    pub redo: Vec<String>,
+    /// The regions file training and analysis use (copied into DIR as regions.toml).
+    #[arg(long, value_name = "FILE")]
+    pub regions: Option<PathBuf>,
+    /// The takes' format: c3d, trc or csv.
+    #[arg(long, default_value = "c3d")]
+    pub format: String,
+    /// Share of the model markers' samples a take must hold, 0.5 to 1.
+    #[arg(long, default_value_t = crate::offline::session::check::DEFAULT_MIN_SEEN)]
+    pub min_seen: f64,
+    /// After finishing, send the model to a running `serve` (/model/load to its control
+    /// socket, HOST:PORT) and report its answer.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub load_into: Option<String>,
+    /// Do not read controls from the keyboard (stdin).
+    #[arg(long)]
+    pub no_keyboard: bool,
+    /// Serve the performer's view (the sentence large, the emotion, take n of N, a recording
+    /// light, the markers seen) at this address [default: 127.0.0.1:9080].
+    #[arg(long, value_name = "IP:PORT", num_args = 0..=1,
+          default_missing_value = crate::serve::session::view::DEFAULT_VIEW)]
+    pub monitor: Option<String>,
+}
+
 /// `emoshift replay`.
 #[derive(Debug, Args)]
 pub struct ReplayArgs {

@@ -8,7 +8,9 @@ mod live;
 mod offline;
 mod values;
 
-pub use live::{BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, WireFormat};
+pub use live::{
+    BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, SessionArgs, WireFormat,
+};
 pub use offline::{
     AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InjectArgs, InspectArgs, KeyValue, ProjectArgs,
     SynthArgs, TrainArgs,
@@ -144,6 +146,16 @@ pub enum Command {
         --natnet-interface 10.0.0.20 --natnet-timecode-rate 29.97df --out take.trc"
     )]
     Record(RecordArgs),
+    /// A new performer's paired calibration session from a live source: prompts for each
+    /// sentence in each emotion, records and checks every take, writes session.toml as it
+    /// goes (--resume continues it), then trains and analyses.
+    #[command(
+        after_help = "Examples:\n  emoshift session perf1 --listen 127.0.0.1:9000 --regions regions.toml\n  \
+        emoshift session perf1 --natnet 192.168.0.106 --performer Face --control 127.0.0.1:9101\n  \
+        emoshift session perf1 --listen 127.0.0.1:9000 --resume --load-into 127.0.0.1:9001\n\n\
+        Keys: Enter starts/stops a take, t retake, s skip, b back, f finish, ? status."
+    )]
+    Session(SessionArgs),
     /// Run the whole chain on an embedded default: synth, train, analyze, serve, replay with an
     /// emotion sweep, receive, summarise.
     #[command(

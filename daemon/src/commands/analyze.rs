@@ -68,13 +68,13 @@ pub(crate) struct Report<'a> {
 
 /// Analyses the model at `model_path` on the session at `manifest`, writes the report and
 /// prints the table, as `analyze` does; returns the model (with roles and levels when
-/// written back).
+/// written back) and the report.
 pub(crate) fn analyze_and_write(
     model_path: &Path,
     manifest: &Path,
     regions: Option<&Path>,
     to: &Report<'_>,
-) -> Result<IcaModel> {
+) -> Result<(IcaModel, analysis::Report)> {
     let mut model = crate::offline::load_model(model_path)?;
     let session = offline::load_session(manifest)?;
     let regions_path = match regions {
@@ -110,7 +110,7 @@ pub(crate) fn analyze_and_write(
     for p in written {
         crate::out!("wrote {}", p.display());
     }
-    Ok(model)
+    Ok((model, report))
 }
 
 /// The components' metrics, the emotion note and the levels, as `analyze` prints them.

@@ -15,6 +15,7 @@ mod regions;
 mod repair;
 mod replay;
 mod serve;
+mod session;
 mod synth;
 mod train;
 
@@ -72,6 +73,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => bench::run(&args),
         Command::Replay(args) => replay::run(&args),
         Command::Record(args) => record::run(&args),
+        Command::Session(args) => session::run(&args),
         Command::Demo(args) => demo::run(&args),
     }
 }

@@ -9,9 +9,23 @@ use crate::exit::UsageError;
 use crate::offline::progress::Progress;
 use crate::serve::capture::{self, CaptureConfig, Notice, Source};
 
-/// The arguments, checked.
-fn config(args: &RecordArgs) -> Result<CaptureConfig> {
-    let source = match (&args.listen, &args.natnet, &args.qtm) {
+/// The live source of `--listen`, `--natnet` (with its options) or `--qtm`, checked.
+pub(crate) fn source(
+    listen: Option<&String>,
+    natnet: Option<&String>,
+    qtm: Option<&String>,
+    natnet_options: &crate::cli::NatNetArgs,
+) -> Result<Source> {
+    Ok(match (listen, natnet, qtm) {
+        (Some(l), None, None) => Source::Osc(
+            l.parse()
+                .map_err(|_| UsageError(format!("--listen: {l:?} is not an IP:PORT address")))?,
+        ),
+        (None, Some(server), None) => {
+            let raw = natnet_options.raw(Some(server.clone()));
+            let n = raw.validate().map_err(|e| UsageError(e.to_string()))?;
+            Source::NatNet(n.expect("a server was given"))
+        }
         (None, None, Some(server)) => {
             let raw = crate::serve::sources::qtm::RawQtm {
                 server: Some(server.clone()),
@@ -20,17 +34,18 @@ fn config(args: &RecordArgs) -> Result<CaptureConfig> {
             let q = raw.validate().map_err(|e| UsageError(e.to_string()))?;
             Source::Qtm(q.expect("a server was given"))
         }
-        (Some(l), None, None) => Source::Osc(
-            l.parse()
-                .map_err(|_| UsageError(format!("--listen: {l:?} is not an IP:PORT address")))?,
-        ),
-        (None, Some(server), None) => {
-            let raw = args.natnet_options.raw(Some(server.clone()));
-            let n = raw.validate().map_err(|e| UsageError(e.to_string()))?;
-            Source::NatNet(n.expect("a server was given"))
-        }
         _ => return Err(UsageError("give one source: --listen, --natnet or --qtm".into()).into()),
-    };
+    })
+}
+
+/// The arguments, checked.
+fn config(args: &RecordArgs) -> Result<CaptureConfig> {
+    let source = source(
+        args.listen.as_ref(),
+        args.natnet.as_ref(),
+        args.qtm.as_ref(),
+        &args.natnet_options,
+    )?;
     if replay::Format::from_path(&args.out).is_none() {
         return Err(UsageError(format!(
             "--out {}: record to a .c3d, .trc or .csv file",

@@ -2,7 +2,8 @@
 //! loading and projecting takes ([`takes`]), preparing captures for training and the model's
 //! quality report ([`training`], streaming long sessions), progress reports ([`progress`]), the
 //! analysis of a paired session ([`analysis`]), edit planning ([`edit`]), real captures cut
-//! into a paired session with a known signal ([`inject`]), and `project` and `edit` streamed
+//! into a paired session with a known signal ([`inject`]), a calibration session's script,
+//! checks and takes ([`session`]), and `project` and `edit` streamed
 //! from file to output in blocks ([`streamed`]).
 
 pub mod analysis;
@@ -11,6 +12,7 @@ pub mod inject;
 pub mod output;
 pub mod progress;
 pub mod regions;
+pub mod session;
 pub mod streamed;
 pub mod takes;
 pub mod training;

@@ -180,6 +180,11 @@ pub(crate) async fn execute(
             .await
         }
         Control::RecordStop => ask(ctx, Command::RecordStop).await,
+        Control::Session(_) => Err(Refusal::Invalid(format!(
+            "{} is a calibration session's control: send it to `emoshift session --control`, \
+             not to serve",
+            control.address()
+        ))),
         other => ask(ctx, Command::Edit(other.clone())).await,
     };
     match result {

@@ -41,12 +41,21 @@ struct Warnings {
 impl Guard {
     /// The rules of `config`.
     pub(crate) fn new(config: &Config) -> Guard {
+        let mut guard =
+            Guard::with_rules(config.control_allow.clone(), config.control_secret.clone());
+        guard.max_model_bytes = config.max_model_bytes;
+        guard
+    }
+
+    /// Who may control (`allow`), and the secret mutating controls carry when one is set: the
+    /// rules of another control socket than serve's (`emoshift session`).
+    pub(crate) fn with_rules(allow: AllowList, secret: Option<String>) -> Guard {
         Guard {
-            allow: config.control_allow.clone(),
-            secret: config.control_secret.clone(),
+            allow,
+            secret,
             cookie_key: RandomState::new(),
             started: Instant::now(),
-            max_model_bytes: config.max_model_bytes,
+            max_model_bytes: super::config::DEFAULT_MAX_MODEL_MB << 20,
             warnings: Mutex::new(Warnings {
                 last: None,
                 suppressed: 0,

@@ -37,6 +37,7 @@ pub mod net;
 pub(crate) mod processing;
 pub mod queue;
 pub(crate) mod server;
+pub mod session;
 pub mod sinks;
 pub mod sources;
 pub mod stats;

@@ -122,6 +122,62 @@ pub enum Control {
     RecordStop,
     /// `/status`: answered with `/status/confirm` and the counters.
     Status,
+    /// `/session/...`: a calibration session's control (`emoshift session`; `serve` refuses
+    /// it).
+    Session(SessionControl),
+}
+
+/// The controls of a calibration session (`emoshift session`), none with arguments.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SessionControl {
+    /// `/session/start`: record the prompted take.
+    Start,
+    /// `/session/stop`: stop recording and check the take.
+    Stop,
+    /// `/session/retake`: record the refused take again, or the last accepted one.
+    Retake,
+    /// `/session/skip`: leave the prompted take out.
+    Skip,
+    /// `/session/back`: go back one take.
+    Back,
+    /// `/session/finish`: train and analyse.
+    Finish,
+    /// `/session/status`: answered with `/session/status/confirm ,iiisss` (see
+    /// [`crate::encode_session_status_into`]).
+    Status,
+}
+
+impl SessionControl {
+    /// Every session control.
+    pub const ALL: [SessionControl; 7] = [
+        SessionControl::Start,
+        SessionControl::Stop,
+        SessionControl::Retake,
+        SessionControl::Skip,
+        SessionControl::Back,
+        SessionControl::Finish,
+        SessionControl::Status,
+    ];
+
+    /// Its OSC address.
+    pub fn address(self) -> &'static str {
+        match self {
+            SessionControl::Start => a::SESSION_START,
+            SessionControl::Stop => a::SESSION_STOP,
+            SessionControl::Retake => a::SESSION_RETAKE,
+            SessionControl::Skip => a::SESSION_SKIP,
+            SessionControl::Back => a::SESSION_BACK,
+            SessionControl::Finish => a::SESSION_FINISH,
+            SessionControl::Status => a::SESSION_STATUS,
+        }
+    }
+
+    /// The control at `address`, if it is one.
+    pub fn parse(address: &str) -> Option<SessionControl> {
+        SessionControl::ALL
+            .into_iter()
+            .find(|c| c.address() == address)
+    }
 }
 
 /// Why a control message was refused; its `Display` text is what `/emoshift/error` carries.
@@ -184,6 +240,7 @@ impl Control {
             Control::RecordStart { .. } => a::RECORD_START,
             Control::RecordStop => a::RECORD_STOP,
             Control::Status => a::STATUS,
+            Control::Session(c) => c.address(),
         }
     }
 
@@ -194,6 +251,7 @@ impl Control {
         !matches!(
             self,
             Control::Status
+                | Control::Session(SessionControl::Status)
                 | Control::EmotionList
                 | Control::Subscribe { .. }
                 | Control::Unsubscribe { .. }
@@ -247,7 +305,9 @@ impl Control {
                 .iter()
                 .flat_map(|(n, w)| [T::String(n.clone()), T::Float(*w)])
                 .collect(),
-            Control::RecordStop | Control::Status | Control::EmotionList => vec![],
+            Control::RecordStop | Control::Status | Control::EmotionList | Control::Session(_) => {
+                vec![]
+            }
         }
     }
 }

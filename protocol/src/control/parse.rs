@@ -4,8 +4,8 @@
 use rosc::{OscMessage, OscPacket, OscType};
 
 use super::{
-    Control, ControlError, Profile, MAX_ALPHA, MAX_GAIN, MAX_MIX_WEIGHT, MAX_NAME_BYTES,
-    MAX_PATH_BYTES, MAX_RAMP_S,
+    Control, ControlError, Profile, SessionControl, MAX_ALPHA, MAX_GAIN, MAX_MIX_WEIGHT,
+    MAX_NAME_BYTES, MAX_PATH_BYTES, MAX_RAMP_S,
 };
 use crate::address as a;
 use crate::error::DecodeError;
@@ -295,13 +295,17 @@ pub(crate) fn parse_control(address: &str, args: Vec<OscType>) -> Result<Control
         (a::RECORD_START, args) => record_start(addr, args).ok_or_else(wrong)??,
         (a::RECORD_STOP, []) => Control::RecordStop,
         (a::STATUS, []) => Control::Status,
+        (addr, []) => match SessionControl::parse(addr) {
+            Some(c) => Control::Session(c),
+            None => return Err(wrong()),
+        },
         _ => return Err(wrong()),
     };
     Ok(c)
 }
 
 /// Control addresses and the type tags each takes (for error messages).
-const CONTROL_SHAPES: [(&str, &str); 14] = [
+const CONTROL_SHAPES: [(&str, &str); 21] = [
     (a::EMOTION_TARGET, ",s"),
     (a::EMOTION_AMOUNT, ",f"),
     (a::EMOTION_RAMP, ",f"),
@@ -316,4 +320,11 @@ const CONTROL_SHAPES: [(&str, &str); 14] = [
     (a::RECORD_START, ",s, ,ss, ,si or ,ssi"),
     (a::RECORD_STOP, ","),
     (a::STATUS, ","),
+    (a::SESSION_START, ","),
+    (a::SESSION_STOP, ","),
+    (a::SESSION_RETAKE, ","),
+    (a::SESSION_SKIP, ","),
+    (a::SESSION_BACK, ","),
+    (a::SESSION_FINISH, ","),
+    (a::SESSION_STATUS, ","),
 ];

@@ -256,3 +256,35 @@ fn the_secret_is_the_last_string_and_only_mutating_controls_need_it() {
     assert!(Control::Amount(0.5).is_mutating());
     assert!(!Control::Status.is_mutating());
 }
+
+#[test]
+fn issue_33_session_controls_round_trip_and_status_is_answered_as_iiisss() {
+    use protocol::{encode_session_status_into, SessionControl, SessionStatus};
+    for c in SessionControl::ALL {
+        let control = Control::Session(c);
+        let mut out = Vec::new();
+        protocol::encode_control_into(&control, &mut out);
+        assert_eq!(decode_control(&out).expect("decodes"), control);
+        assert_eq!(control.is_mutating(), c != SessionControl::Status);
+    }
+    let status = SessionStatus {
+        take: 3,
+        takes: 32,
+        sentence: 1,
+        emotion: "sad".into(),
+        state: "review".into(),
+        text: "The birch canoe slid on the smooth planks.".into(),
+    };
+    let mut out = Vec::new();
+    encode_session_status_into(&status, &mut out);
+    assert!(out.starts_with(b"/session/status/confirm\0,iiisss\0"));
+    assert_eq!(
+        protocol::decode_reply(&out).expect("a reply"),
+        protocol::Reply::SessionStatus(status)
+    );
+    let with_arg = decode_control(&msg("/session/start", vec![OscType::Int(1)]));
+    assert!(
+        with_arg.is_err(),
+        "session controls take no arguments: {with_arg:?}"
+    );
+}

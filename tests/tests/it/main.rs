@@ -9,6 +9,7 @@ mod issue_37;
 mod monitor;
 mod natnet;
 mod regression_30;
+mod session;
 mod shutdown;
 mod stage;
 mod support;

@@ -109,7 +109,7 @@ fn chain(args: &DemoArgs, dir: &Path, started: Instant) -> Result<()> {
         axes: crate::offline::analysis::Axes::default(),
     };
     let regions = session.regions.as_deref();
-    let model = analyze_and_write(&model_path, &session.manifest, regions, &report)?;
+    let (model, _) = analyze_and_write(&model_path, &session.manifest, regions, &report)?;
     let take = Arc::new(crate::offline::load_take(&session.take)?);
     if let Some(addr) = &args.monitor {
         step(

@@ -85,8 +85,7 @@ pub struct CaptureConfig {
 /// The take and what the notices need, shared by the receive loop and the status callback.
 struct State {
     take: Take,
-    last_frame: Option<Instant>,
-    quiet_told: bool,
+    quiet: Quiet,
     /// Whether the missing `--performer` was told.
     wrong_told: bool,
     error: Option<anyhow::Error>,
@@ -100,8 +99,7 @@ impl State {
     }
 
     fn push(&mut self, f: &Incoming<'_>) {
-        self.last_frame = Some(f.received);
-        self.quiet_told = false;
+        self.quiet.heard(f.received);
         if self.error.is_none() {
             if let Err(e) = self.take.push(f) {
                 self.error = Some(e);
@@ -139,14 +137,63 @@ impl State {
                 return Some(line);
             }
         }
+        self.quiet.notice(since, what)
+    }
+}
+
+/// When a frame last came, for the notice that nothing arrives (shared by a source's sink and
+/// its quiet timer).
+#[derive(Debug, Default)]
+pub struct Quiet {
+    last_frame: Option<Instant>,
+    told: bool,
+}
+
+impl Quiet {
+    /// A frame arrived at `at`.
+    pub fn heard(&mut self, at: Instant) {
+        self.last_frame = Some(at);
+        self.told = false;
+    }
+
+    /// A notice when nothing came for [`QUIET`] (once per quiet spell).
+    fn notice(&mut self, since: Instant, what: impl FnOnce() -> String) -> Option<String> {
         let quiet_from = self.last_frame.unwrap_or(since);
-        if self.quiet_told || quiet_from.elapsed() < QUIET {
+        if self.told || quiet_from.elapsed() < QUIET {
             return None;
         }
-        self.quiet_told = true;
+        self.told = true;
         Some(what())
     }
 }
+
+/// The stream name a frame is recorded under: its performer, else `ip:port/layout`.
+pub fn stream_name(frame: &SourceFrame<'_>) -> String {
+    match frame.performer {
+        Some(name) => name.to_string(),
+        None => format!("{}/{}", frame.key.source, frame.key.layout_id),
+    }
+}
+
+/// One frame as [`Take::push`] takes it.
+pub fn incoming<'a>(
+    frame: &'a SourceFrame<'_>,
+    arrival: &Arrival,
+    stream: &'a str,
+) -> Incoming<'a> {
+    Incoming {
+        stream,
+        labels: frame.labels,
+        frame: frame.frame,
+        header: frame.frame.header(),
+        timecode: frame.time.timecode,
+        announced_rate_hz: arrival.announced_rate_hz,
+        received: arrival.received,
+    }
+}
+
+/// Hears a source's status ticks (a few a second) with the text that says why nothing arrives.
+type OnTick<'a> = dyn FnMut(&dyn Fn() -> String) + Send + 'a;
 
 /// Captures until done or `shutdown`; `notice` hears the quiet lines and the progress. `None`
 /// when no frame of the stream arrived (no file is left).
@@ -160,36 +207,22 @@ pub async fn run(
 ) -> Result<Option<Captured>> {
     let state = Mutex::new(State {
         take: Take::new(&config.out, config.performer.clone()),
-        last_frame: None,
-        quiet_told: false,
+        quiet: Quiet::default(),
         wrong_told: false,
         error: None,
     });
     let stop = shutdown.child_token();
     let mut sink = |frame: &SourceFrame<'_>, arrival: &Arrival| {
-        let stream = match frame.performer {
-            Some(name) => name.to_string(),
-            None => format!("{}/{}", frame.key.source, frame.key.layout_id),
-        };
+        let stream = stream_name(frame);
         let mut s = lock(&state);
-        s.push(&Incoming {
-            stream: &stream,
-            labels: frame.labels,
-            frame: frame.frame,
-            header: frame.frame.header(),
-            timecode: frame.time.timecode,
-            announced_rate_hz: arrival.announced_rate_hz,
-            received: arrival.received,
-        });
+        s.push(&incoming(frame, arrival, &stream));
         if s.done(&config) {
             stop.cancel();
         }
     };
-    match &config.source {
-        Source::Osc(addr) => osc(*addr, &state, &stop, &mut sink, notice).await?,
-        Source::NatNet(n) => natnet(n.clone(), &state, &stop, &mut sink, notice).await?,
-        Source::Qtm(q) => qtm(q.clone(), &state, &stop, &mut sink, notice).await?,
-    }
+    let started = Instant::now();
+    let mut on_tick = |what: &dyn Fn() -> String| lock(&state).tick(started, what, notice);
+    drive(&config.source, &stop, &mut sink, &mut on_tick).await?;
     let state = state
         .into_inner()
         .map_err(|_| anyhow::anyhow!("capture state poisoned"))?;
@@ -215,13 +248,51 @@ fn wrong_performer(take: &Take) -> Option<String> {
     ))
 }
 
-/// The OSC source on `addr` until `stop`, with a quiet notice while nothing comes.
-async fn osc(
-    addr: SocketAddr,
-    state: &Mutex<State>,
+/// The source until `stop`, each frame to `sink`, with a notice (to `notice`) while nothing
+/// comes (`sink` tells `quiet` of each frame): for a caller with its own takes (`session`).
+///
+/// # Errors
+/// A socket that cannot be bound.
+pub async fn listen(
+    source: &Source,
+    quiet: &Mutex<Quiet>,
     stop: &CancellationToken,
     sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
-    notice: &mut OnNotice<'_>,
+    notice: &mut (dyn FnMut(&str) + Send),
+) -> Result<()> {
+    let started = Instant::now();
+    let mut on_tick = |what: &dyn Fn() -> String| {
+        let line = quiet
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .notice(started, what);
+        if let Some(line) = line {
+            notice(&line);
+        }
+    };
+    drive(source, stop, sink, &mut on_tick).await
+}
+
+/// The source until `stop`, each frame to `sink`, `on_tick` a few times a second.
+async fn drive(
+    source: &Source,
+    stop: &CancellationToken,
+    sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
+    on_tick: &mut OnTick<'_>,
+) -> Result<()> {
+    match source {
+        Source::Osc(addr) => osc(*addr, stop, sink, on_tick).await,
+        Source::NatNet(n) => natnet(n.clone(), stop, sink, on_tick).await,
+        Source::Qtm(q) => qtm(q.clone(), stop, sink, on_tick).await,
+    }
+}
+
+/// The OSC source on `addr` until `stop`, ticking every 250 ms.
+async fn osc(
+    addr: SocketAddr,
+    stop: &CancellationToken,
+    sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
+    on_tick: &mut OnTick<'_>,
 ) -> Result<()> {
     let socket = super::net::bind_receiver(addr)
         .with_context(|| format!("binding the frame socket {addr}"))?;
@@ -235,7 +306,6 @@ async fn osc(
         counters: Arc::new(InputCounters::named("osc")),
         max_markers: protocol::MAX_FRAME_MARKERS,
     };
-    let started = Instant::now();
     let quiet = async {
         let mut tick = tokio::time::interval(Duration::from_millis(250));
         loop {
@@ -250,62 +320,54 @@ async fn osc(
                     QUIET.as_secs()
                 )
             };
-            lock(state).tick(started, quiet, notice);
+            on_tick(&quiet);
         }
     };
     tokio::join!(super::sources::osc::run(source, sink, stop.clone()), quiet);
     Ok(())
 }
 
-/// The NatNet source until `stop`, with a quiet notice while nothing comes.
+/// The NatNet source until `stop`, ticking on each of the link's status reports.
 async fn natnet(
     n: NatNetConfig,
-    state: &Mutex<State>,
     stop: &CancellationToken,
     sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
-    notice: &mut OnNotice<'_>,
+    on_tick: &mut OnTick<'_>,
 ) -> Result<()> {
     let server = n.server;
     let link = Link::open(n, Arc::new(InputCounters::named("natnet")))?;
-    let started = Instant::now();
-    let mut on_status = |st: &NatNetStatus| {
-        lock(state).tick(started, || natnet_quiet(server, st), notice);
-    };
+    let mut on_status = |st: &NatNetStatus| on_tick(&|| natnet_quiet(server, st));
     link.run(stop.clone(), sink, &mut on_status).await
 }
 
 /// The QTM source until `stop`, with a quiet notice while nothing comes.
 async fn qtm(
     q: QtmConfig,
-    state: &Mutex<State>,
     stop: &CancellationToken,
     sink: &mut (dyn FnMut(&SourceFrame<'_>, &Arrival) + Send),
-    notice: &mut OnNotice<'_>,
+    on_tick: &mut OnTick<'_>,
 ) -> Result<()> {
-    let started = Instant::now();
-    let mut on_status = |st: &QtmStatus| {
-        lock(state).tick(
-            started,
-            || {
-                let secs = QUIET.as_secs();
-                match st.connected {
-                    false => format!(
-                        "no session with QTM at {} for {secs} s: is QTM running there with \
-                     real-time output on (Project Options > Real-Time Output)?",
-                        st.server
-                    ),
-                    true => format!(
-                        "connected to QTM at {}, but no frames for {secs} s: is a measurement \
-                     running (or RT from file), with 3D tracking on?",
-                        st.server
-                    ),
-                }
-            },
-            notice,
-        );
-    };
+    let mut on_status = |st: &QtmStatus| on_tick(&|| qtm_quiet(st));
     let counters = Arc::new(InputCounters::named("qtm"));
     super::sources::qtm::run(q, counters, stop.clone(), sink, &mut on_status).await
+}
+
+/// Why nothing arrives from QTM, as far as the session can tell.
+fn qtm_quiet(st: &QtmStatus) -> String {
+    let secs = QUIET.as_secs();
+    if st.connected {
+        format!(
+            "connected to QTM at {}, but no frames for {secs} s: is a measurement running (or \
+             RT from file), with 3D tracking on?",
+            st.server
+        )
+    } else {
+        format!(
+            "no session with QTM at {} for {secs} s: is QTM running there with real-time \
+             output on (Project Options > Real-Time Output)?",
+            st.server
+        )
+    }
 }
 
 /// Why nothing arrives from a NatNet server, as far as the session can tell.

@@ -63,6 +63,7 @@ pub struct Take {
     first_timecode: Option<Smpte>,
     frames: u64,
     gaps: u64,
+    relabelled: u64,
     xyz: Vec<f32>,
     missing: Vec<bool>,
 }
@@ -104,6 +105,7 @@ impl Take {
             first_timecode: None,
             frames: 0,
             gaps: 0,
+            relabelled: 0,
             xyz: Vec::new(),
             missing: Vec::new(),
         }
@@ -117,6 +119,12 @@ impl Take {
     /// Frames written as gaps so far.
     pub fn gaps(&self) -> u64 {
         self.gaps
+    }
+
+    /// Frames of the stream that came with other labels than its first frame's (a label
+    /// change mid-take), left out.
+    pub fn relabelled(&self) -> u64 {
+        self.relabelled
     }
 
     /// The stream being recorded, once one was chosen.
@@ -186,6 +194,7 @@ impl Take {
         match &self.stream {
             Some((name, labels)) => {
                 if name != f.stream || labels.as_slice() != f.labels {
+                    self.relabelled += u64::from(name == f.stream);
                     if !self.others.iter().any(|o| o == f.stream) && name != f.stream {
                         self.others.push(f.stream.to_string());
                     }

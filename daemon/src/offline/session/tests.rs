@@ -1,0 +1,89 @@
+use protocol::SessionControl as C;
+
+use super::script::Script;
+use super::*;
+
+fn sitting() -> Sitting {
+    Sitting::new(Script::harvard(2), "c3d")
+}
+
+#[test]
+fn takes_advance_on_acceptance_and_stay_on_refusal() {
+    let mut s = sitting();
+    assert_eq!(s.takes(), 8);
+    assert!(s.handle(C::Stop).is_err());
+    let Ok(Step::Record { prompt, replaces }) = s.handle(C::Start) else {
+        panic!("start records");
+    };
+    assert_eq!(
+        (prompt.sentence, prompt.emotion.as_str(), replaces),
+        (0, "neutral", false)
+    );
+    assert_eq!(s.status().state, "recording");
+    assert!(s.handle(C::Skip).is_err(), "no skip while recording");
+    assert_eq!(s.handle(C::Stop), Ok(Step::Stop));
+    s.handle_checked(Err("markers missing".into()));
+    assert_eq!(s.status().state, "review");
+    assert_eq!(s.status().take, 0);
+    assert!(matches!(s.handle(C::Retake), Ok(Step::Record { .. })));
+    s.handle_checked(Ok(120.0));
+    let st = s.status();
+    assert_eq!(
+        (st.take, st.takes, st.sentence, st.state.as_str()),
+        (1, 8, 1, "waiting")
+    );
+    assert_eq!(
+        s.manifest().expect("one take").takes[0].file,
+        "s01_neutral.c3d"
+    );
+}
+
+#[test]
+fn a_skipped_take_comes_back_at_the_end_and_resume_continues_where_it_stopped() {
+    let mut s = sitting();
+    assert_eq!(s.handle(C::Skip), Ok(Step::Moved));
+    for _ in 1..8 {
+        assert!(matches!(s.handle(C::Start), Ok(Step::Record { .. })));
+        s.handle(C::Stop).expect("recording");
+        s.handle_checked(Ok(100.0));
+    }
+    assert_eq!(s.cursor(), 0, "the skipped take is offered again");
+    let manifest = s.manifest().expect("takes");
+    assert_eq!(manifest.takes.len(), 7);
+    let resumed = Sitting::resume(Script::harvard(2), "c3d", &manifest);
+    assert_eq!((resumed.cursor(), resumed.accepted()), (0, 7));
+    assert_eq!(resumed.manifest().expect("takes"), manifest);
+    s.handle(C::Start).expect("start");
+    s.handle(C::Stop).expect("stop");
+    s.handle_checked(Ok(100.0));
+    assert_eq!(s.status().state, "done");
+    assert_eq!(s.status().take, 8);
+    // Retake from done: the last accepted take, replacing it.
+    assert!(matches!(
+        s.handle(C::Retake),
+        Ok(Step::Record { replaces: true, .. })
+    ));
+}
+
+#[test]
+fn redo_offers_named_takes_again_and_refuses_unknown_names() {
+    let mut s = sitting();
+    for _ in 0..8 {
+        s.handle(C::Start).expect("start");
+        s.handle(C::Stop).expect("stop");
+        s.handle_checked(Ok(120.0));
+    }
+    assert_eq!(s.status().state, "done");
+    s.redo(&["s02_sad".into(), "s01_happy.c3d".into()])
+        .expect("known takes");
+    assert_eq!((s.accepted(), s.status().state.as_str()), (6, "waiting"));
+    assert_eq!(s.prompt().file_name("c3d"), "s01_happy.c3d");
+    assert!(matches!(
+        s.handle(C::Start),
+        Ok(Step::Record {
+            replaces: false,
+            ..
+        })
+    ));
+    assert!(s.redo(&["s09_sad".into()]).is_err());
+}
