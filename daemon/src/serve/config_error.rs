@@ -2,7 +2,7 @@
 //! (the service's keys, a source's, the monitor's), each naming the key and the value. A leaf:
 //! the parts that check keys import it, it imports none of them.
 
-use std::net::SocketAddr;
+use std::net::{IpAddr, SocketAddr};
 
 /// Why a configuration is refused; each names the key and the value.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -63,4 +63,25 @@ pub enum ConfigError {
         /// The control socket.
         control: SocketAddr,
     },
+}
+
+/// A config value `IP` or `IP:PORT` (`port` when none is given), for the server outputs'
+/// addresses; an error names `key`.
+///
+/// # Errors
+/// [`ConfigError::Address`] when `text` is neither.
+pub(crate) fn parse_addr(
+    key: &'static str,
+    text: &str,
+    port: u16,
+) -> Result<SocketAddr, ConfigError> {
+    if let Ok(a) = text.parse::<SocketAddr>() {
+        return Ok(a);
+    }
+    text.parse::<IpAddr>()
+        .map(|ip| SocketAddr::new(ip, port))
+        .map_err(|_| ConfigError::Address {
+            key,
+            value: text.to_string(),
+        })
 }

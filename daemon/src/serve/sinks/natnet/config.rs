@@ -5,7 +5,7 @@ use std::net::{IpAddr, Ipv4Addr, SocketAddr, SocketAddrV4};
 
 use protocol::natnet::{NatNetVersion, DEFAULT_COMMAND_PORT, DEFAULT_MULTICAST_GROUP};
 
-use crate::serve::config_error::ConfigError;
+use crate::serve::config_error::{parse_addr, ConfigError};
 
 /// The default command address: Motive's port, loopback only.
 pub const DEFAULT_NATNET_SERVER: &str = "127.0.0.1:1510";
@@ -123,19 +123,6 @@ impl RawNatNetServer {
             max_clients,
         }))
     }
-}
-
-/// `IP` or `IP:PORT`.
-fn parse_addr(key: &'static str, text: &str, port: u16) -> Result<SocketAddr, ConfigError> {
-    if let Ok(a) = text.parse::<SocketAddr>() {
-        return Ok(a);
-    }
-    text.parse::<IpAddr>()
-        .map(|ip| SocketAddr::new(ip, port))
-        .map_err(|_| ConfigError::Address {
-            key,
-            value: text.to_string(),
-        })
 }
 
 /// `GROUP[:PORT]`, an IPv4 multicast group (an empty text: Motive's default group).

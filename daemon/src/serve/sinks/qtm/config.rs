@@ -1,11 +1,11 @@
 //! The QTM server's settings: the `qtm_server*` keys of the config (and their flags), checked
 //! once into a [`QtmServerConfig`].
 
-use std::net::{IpAddr, SocketAddr};
+use std::net::SocketAddr;
 
 use protocol::qtm::{DEFAULT_PORT, DISCOVERY_PORT};
 
-use crate::serve::config_error::ConfigError;
+use crate::serve::config_error::{parse_addr, ConfigError};
 
 /// The default address: QTM's little-endian RT port, loopback only.
 pub const DEFAULT_QTM_SERVER: &str = "127.0.0.1:22223";
@@ -71,19 +71,6 @@ impl RawQtmServer {
             discovery,
         }))
     }
-}
-
-/// `IP` or `IP:PORT`.
-fn parse_addr(key: &'static str, text: &str, port: u16) -> Result<SocketAddr, ConfigError> {
-    if let Ok(a) = text.parse::<SocketAddr>() {
-        return Ok(a);
-    }
-    text.parse::<IpAddr>()
-        .map(|ip| SocketAddr::new(ip, port))
-        .map_err(|_| ConfigError::Address {
-            key,
-            value: text.to_string(),
-        })
 }
 
 #[cfg(test)]
