@@ -112,7 +112,8 @@ fn sitting(args: &SessionArgs) -> Result<Sitting> {
 }
 
 fn read_script(path: &Path) -> Result<Script> {
-    let text = std::fs::read_to_string(path)
+    // Bounded like every text input: `--script /dev/zero` is refused, not read forever.
+    let text = replay::file::read_to_string_bounded(path, replay::file::DEFAULT_MAX_TEXT_BYTES)
         .with_context(|| format!("cannot read the script {}", path.display()))?;
     Script::parse(&text).map_err(|e| UsageError(format!("{}: {e}", path.display())).into())
 }
