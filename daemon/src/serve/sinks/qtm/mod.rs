@@ -270,8 +270,7 @@ impl Sink for QtmSink {
     }
 
     fn handle_frame(&mut self, f: &Processed<'_>) {
-        let hub = Arc::clone(&self.hub);
-        let Ok(mut hub) = hub.lock() else {
+        let Ok(mut hub) = self.hub.lock() else {
             return;
         };
         hub.layout.handle_frame(f);
