@@ -104,5 +104,5 @@ pub use scan::{
 };
 pub use timecode::{
     append_timecode_element, decode_timecode, encode_frame_timed_into, encode_timecode_into,
-    CaptureClock, FrameTime, Smpte, TimecodeError, TimecodeRate, TIMECODE_MESSAGE_LEN,
+    CaptureClock, FrameTime, Irig, Smpte, TimecodeError, TimecodeRate, TIMECODE_MESSAGE_LEN,
 };

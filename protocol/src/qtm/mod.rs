@@ -41,6 +41,7 @@ pub mod event;
 pub mod packet;
 pub mod params;
 pub mod params_read;
+mod timecode;
 
 pub use command::{parse_command, Command, Components, ParameterSet, Rate, Transport};
 pub use data::{decode_data_into, encode_data_into, DataFrame, FrameIn, Timecode};

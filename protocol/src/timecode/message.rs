@@ -132,5 +132,9 @@ pub fn decode_timecode(msg: &[u8]) -> Result<FrameTime, DecodeError> {
     } else {
         CaptureClock::Source
     };
-    Ok(FrameTime { timecode, clock })
+    Ok(FrameTime {
+        timecode,
+        irig: None,
+        clock,
+    })
 }

@@ -1,5 +1,6 @@
-//! The source's time of a frame: SMPTE timecode (`hh:mm:ss:ff`, subframe, rate, drop-frame)
-//! and what the frame's capture time means ([`FrameTime`]); `/mocap/timecode`, its OSC form.
+//! The source's time of a frame: SMPTE timecode (`hh:mm:ss:ff`, subframe, rate, drop-frame),
+//! IRIG time of day ([`Irig`], from QTM) and what the frame's capture time means
+//! ([`FrameTime`]); `/mocap/timecode`, its OSC form (SMPTE only).
 //!
 //! # `/mocap/timecode ,iiiii`
 //!
@@ -351,18 +352,26 @@ pub enum CaptureClock {
 pub struct FrameTime {
     /// SMPTE timecode, when the source stamps one.
     pub timecode: Option<Smpte>,
+    /// IRIG time of day, when the source stamps one (QTM with an IRIG clock). Only QTM's
+    /// output says it again; NatNet and `/mocap/timecode` carry SMPTE only, so a frame with
+    /// IRIG alone goes out there without a timecode.
+    pub irig: Option<Irig>,
     /// What the capture time is measured on.
     pub clock: CaptureClock,
 }
 
 impl FrameTime {
-    /// Whether there is anything to send (a timecode, or a clock other than the source's).
+    /// Whether there is anything to send as `/mocap/timecode` (an SMPTE timecode, or a clock
+    /// other than the source's).
     pub fn is_some(&self) -> bool {
         self.timecode.is_some() || self.clock != CaptureClock::Source
     }
 }
 
+mod irig;
 mod message;
+
+pub use irig::Irig;
 
 pub use message::{
     append_timecode_element, decode_timecode, encode_frame_timed_into, encode_timecode_into,

@@ -78,6 +78,7 @@ fn the_message_round_trips_and_rides_in_the_frame_bundle() {
             subframe: 3,
             rate: Some(df()),
         }),
+        irig: None,
         clock: CaptureClock::Utc,
     };
     let mut out = Vec::new();
@@ -100,6 +101,7 @@ fn the_message_round_trips_and_rides_in_the_frame_bundle() {
 fn bad_messages_name_the_bad_argument() {
     let base = FrameTime {
         timecode: Some(Smpte::from_packed(0x0001_0002, 0, Some(df()))),
+        irig: None,
         clock: CaptureClock::Source,
     };
     let mut good = Vec::new();

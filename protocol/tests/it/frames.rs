@@ -190,6 +190,7 @@ fn a_109_marker_compact_bundle_fits_one_ethernet_payload() {
     assert_eq!(n, 1_464);
     let utc = protocol::FrameTime {
         timecode: None,
+        irig: None,
         clock: protocol::CaptureClock::Utc,
     };
     protocol::append_timecode_element(&utc, &mut out);

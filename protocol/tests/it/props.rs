@@ -172,6 +172,7 @@ proptest! {
         t.subframe = sub;
         let time = FrameTime {
             timecode: has.then_some(t),
+            irig: None,
             clock: if utc { CaptureClock::Utc } else { CaptureClock::Source },
         };
         let mut out = Vec::new();

@@ -212,6 +212,7 @@ pub(super) async fn send_osc(m: &ModelFile, to: SocketAddr, range: std::ops::Ran
         buf.set_frame(n as i32, 0, &mm).expect("finite");
         let time = FrameTime {
             timecode: Some(tc),
+            irig: None,
             clock: CaptureClock::Source,
         };
         protocol::encode_frame_timed_into(&buf, &time, &mut bytes).expect("finite");

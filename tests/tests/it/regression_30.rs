@@ -252,10 +252,12 @@ async fn osc_take() -> (Vec<Vec<Vec<u8>>>, Vec<Vec<u8>>) {
         let time = match index {
             0..120 => FrameTime {
                 timecode: Some(timecode(index)),
+                irig: None,
                 clock: CaptureClock::Utc,
             },
             120..200 => FrameTime {
                 timecode: Some(timecode(index)),
+                irig: None,
                 clock: CaptureClock::Source,
             },
             _ => FrameTime::default(),

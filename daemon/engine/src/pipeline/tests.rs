@@ -199,6 +199,7 @@ fn the_source_time_travels_with_its_frame() {
     frame_into(&model, 0, &mut xyz);
     let time = FrameTime {
         timecode: Some(Smpte::from_frame_count(1_800, TimecodeRate::DF_29_97)),
+        irig: None,
         clock: CaptureClock::Utc,
     };
     let mut src = Src::new(peer(), &model, false);

@@ -3,7 +3,7 @@
 //! `<performer>_` when there are several streams, which a QTM source's `qtm_performers`
 //! prefixes take apart again). A frame of one stream brings its own markers; the others keep
 //! their latest. Markers missing in the input are NaN, as QTM sends them. The frame number,
-//! capture time (µs) and SMPTE timecode are the source's.
+//! capture time (µs) and SMPTE or IRIG timecode are the source's.
 
 use std::sync::Arc;
 
@@ -63,13 +63,7 @@ impl Layout {
         let header = f.output.header();
         self.frame_number = header.frame_number as u32;
         self.timestamp_us = header.capture_time_us;
-        self.timecode = f.time.timecode.map(|t| Timecode::Smpte {
-            hours: t.hours,
-            minutes: t.minutes,
-            seconds: t.seconds,
-            frames: t.frames,
-            subframes: u16::try_from(t.subframe).unwrap_or(u16::MAX),
-        });
+        self.timecode = Timecode::from_frame_time(f.time);
         self.rate_hz = f.rate_hz();
         self.has_frame = true;
     }

@@ -251,6 +251,7 @@ impl NatNetFrames {
             .filter(Smpte::is_valid);
         FrameTime {
             timecode,
+            irig: None,
             clock: CaptureClock::Source,
         }
     }

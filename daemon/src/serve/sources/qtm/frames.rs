@@ -3,14 +3,14 @@
 //! performer is one stream of the labels with its prefix, the prefix taken off (the model's
 //! labels are the bare names); with no performers configured, one stream of every label. A
 //! marker QTM did not see (NaN) is missing; the frame number, the timestamp (µs, as the capture
-//! time on the source's clock) and the SMPTE timecode are QTM's.
+//! time on the source's clock) and the SMPTE or IRIG timecode are QTM's.
 
 use std::net::SocketAddr;
 use std::sync::Arc;
 
 use engine::{SourceFrame, StreamKey};
-use protocol::qtm::{decode_data_into, FrameIn, QtmError, QtmParameters, Timecode};
-use protocol::{CaptureClock, FrameBuf, FrameTime, Smpte};
+use protocol::qtm::{decode_data_into, FrameIn, QtmError, QtmParameters};
+use protocol::{FrameBuf, FrameTime};
 
 /// One stream: a performer's labels (or all of them).
 #[derive(Debug, Clone)]
@@ -126,10 +126,10 @@ impl QtmFrames {
         if f.marker_count() != self.label_count {
             return Ok(Outcome::Mismatch);
         }
-        let time = FrameTime {
-            timecode: f.timecode.and_then(smpte),
-            clock: CaptureClock::Source,
-        };
+        let mut time = FrameTime::default();
+        if let Some(t) = f.timecode {
+            t.set_frame_time(&mut time);
+        }
         let all = f.positions();
         let frame_number = f.frame_number as i32;
         for l in &self.layouts {
@@ -155,27 +155,6 @@ impl QtmFrames {
             });
         }
         Ok(Outcome::Frames(self.layouts.len()))
-    }
-}
-
-/// QTM's SMPTE timecode as emoshift's (IRIG and camera time are not SMPTE: none).
-fn smpte(t: Timecode) -> Option<Smpte> {
-    match t {
-        Timecode::Smpte {
-            hours,
-            minutes,
-            seconds,
-            frames,
-            subframes,
-        } => Some(Smpte {
-            hours,
-            minutes,
-            seconds,
-            frames,
-            subframe: u32::from(subframes),
-            rate: None,
-        }),
-        _ => None,
     }
 }
 

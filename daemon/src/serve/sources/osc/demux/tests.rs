@@ -82,6 +82,7 @@ fn the_timecode_in_a_datagram_is_its_frames_time() {
     let mut d = OscDemux::new(100, Arc::new(InputCounters::default()));
     let time = FrameTime {
         timecode: Some(Smpte::from_frame_count(1_800, TimecodeRate::DF_29_97)),
+        irig: None,
         clock: CaptureClock::Utc,
     };
     let mut got = Vec::new();

@@ -1,4 +1,5 @@
-use protocol::qtm::{encode_data_into, Components, DataFrame, HEADER_BYTES};
+use protocol::qtm::{encode_data_into, Components, DataFrame, Timecode, HEADER_BYTES};
+use protocol::Irig;
 
 use super::*;
 
@@ -94,4 +95,43 @@ fn without_performers_one_stream_has_every_label() {
         })
         .expect("valid");
     assert_eq!(n, 1);
+}
+
+/// Issue 32: QTM's IRIG timecode is the frame's IRIG time (and no SMPTE timecode).
+#[test]
+fn irig_timecode_is_the_frames_irig_time() {
+    let server = "127.0.0.1:22223".parse().expect("addr");
+    let mut frames = QtmFrames::new(server, 16);
+    frames.set_parameters(&params(&["a"]), &[]);
+    let tc = Timecode::Irig {
+        years: 26,
+        days: 332,
+        hours: 8,
+        minutes: 59,
+        seconds: 30,
+        tenths: 4,
+    };
+    let bytes = packet(5, &[1.0, 2.0, 3.0], Some(tc));
+    let mut buf = FrameBuf::with_max_markers(16);
+    let mut got = None;
+    frames
+        .handle_data(&bytes[HEADER_BYTES..], &mut buf, &mut |f| {
+            got = Some(f.time)
+        })
+        .expect("valid");
+    let time = got.expect("one frame");
+    assert_eq!(time.timecode, None);
+    let irig = time.irig.expect("IRIG");
+    assert_eq!(irig.to_string(), "26:332:08:59:30.4");
+    assert_eq!(
+        irig,
+        Irig {
+            year: 26,
+            day: 332,
+            hours: 8,
+            minutes: 59,
+            seconds: 30,
+            tenths: 4
+        }
+    );
 }
