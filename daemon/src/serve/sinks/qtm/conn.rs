@@ -175,7 +175,9 @@ fn far_future() -> tokio::time::Instant {
     tokio::time::Instant::now() + Duration::from_secs(86_400 * 365)
 }
 
-/// Answers discovery requests from allowed hosts with emoshift's name and the RT `port`.
+/// Answers discovery requests from allowed hosts with emoshift's name and the base port of the
+/// RT `port`: QTM answers 22222 for its little-endian port 22223, and the C++ SDK's `Connect`
+/// (under QTM Connect for Unreal, Unity, MotionBuilder) adds 1 to the base port it is given.
 pub async fn discovery(
     socket: UdpSocket,
     port: u16,
@@ -199,7 +201,7 @@ pub async fn discovery(
         let Ok(reply_port) = decode_discover(&buf[..n]) else {
             continue;
         };
-        encode_discover_reply_into(info, port, &mut out);
+        encode_discover_reply_into(info, port.saturating_sub(1), &mut out);
         if socket.send_to(&out, (peer.ip(), reply_port)).await.is_ok() {
             if let Ok(mut h) = hub.lock() {
                 h.counters.discoveries += 1;

@@ -11,7 +11,8 @@
 //!   TCP connection ([`outbox`]: a client that does not read loses frames, never the frame
 //!   path) or as UDP datagrams to its own address.
 //! - **Discovery** (UDP 22226, `qtm_server_discovery`): answered with emoshift's name and the
-//!   RT port.
+//!   base port, one below the RT port (22222 for 22223), as QTM answers: the SDKs connect to
+//!   the base port + 1 for little endian.
 //!
 //! `/status` carries `qtm_server/*`: clients, labels, frames sent and dropped, and every
 //! refusal counted.
