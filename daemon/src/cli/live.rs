@@ -144,6 +144,11 @@ pub struct BenchArgs {
     /// output's in the same run, as a ratio.
     #[arg(long)]
     pub natnet_server: bool,
+    /// Also run rounds with a QTM RT client (TCP, `StreamFrames AllFrames 3D`) on the daemon's
+    /// `--qtm-server` beside the OSC receivers: the QTM output's added latency against the OSC
+    /// compact output's in the same run, as a ratio.
+    #[arg(long)]
+    pub qtm_server: bool,
 }
 
 /// `emoshift record`.

@@ -23,6 +23,8 @@ pub struct Daemon {
     pub monitor: Option<SocketAddr>,
     /// The NatNet server's command address, when `natnet_server` is set.
     pub natnet_server: Option<SocketAddr>,
+    /// The QTM server's RT address, when `qtm_server` is set.
+    pub qtm_server: Option<SocketAddr>,
     shutdown: CancellationToken,
     done: Option<tokio::sync::oneshot::Receiver<Result<()>>>,
 }
@@ -56,13 +58,14 @@ impl Daemon {
                 let _ = done_tx.send(result);
             })
             .context("cannot start the daemon thread")?;
-        let (frames, control, monitor, natnet_server) =
+        let (frames, control, monitor, natnet_server, qtm_server) =
             bound_rx.await.context("the daemon thread ended")??;
         Ok(Daemon {
             frames,
             control,
             monitor,
             natnet_server,
+            qtm_server,
             shutdown,
             done: Some(done),
         })
@@ -110,6 +113,7 @@ type Bound = Result<(
     SocketAddr,
     Option<SocketAddr>,
     Option<SocketAddr>,
+    Option<SocketAddr>,
 )>;
 
 fn serve_until(
@@ -133,7 +137,8 @@ fn serve_until(
             .map_err(|e| anyhow::anyhow!("{e:#}"))
             .and_then(|b| {
                 let (frames, control) = (b.frame_addr()?, b.control_addr()?);
-                Ok((frames, control, b.monitor_addr()?, b.natnet_server_addr()?))
+                let servers = (b.natnet_server_addr()?, b.qtm_server_addr()?);
+                Ok((frames, control, b.monitor_addr()?, servers.0, servers.1))
             });
         let _ = bound_tx.send(addrs);
         bound?.run(shutdown).await

@@ -17,14 +17,17 @@
 //! multicast loopback is part of the path) and unicast, each compared with the OSC source
 //! measured in the same run.
 //!
-//! With `--natnet-server`, rounds with a NatNet client on the daemon's NatNet server beside
-//! the OSC receivers ([`natnet_server`]): the two outputs' latencies from the same frames.
+//! With `--natnet-server` and `--qtm-server`, rounds with a NatNet client on the daemon's
+//! NatNet server, or a QTM RT client on its QTM server, beside the OSC receivers
+//! ([`server_outputs`]), interleaved with the other rounds: each output's latency against the
+//! OSC compact output's from the same frames.
 //!
 //! Bounded in time, only 127.0.0.1.
 
 mod harness;
 mod natnet;
-mod natnet_server;
+mod qtm_client;
+mod server_outputs;
 
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -41,6 +44,7 @@ use crate::serve::sinks::osc::encode::{EncodeOnly, Profiles};
 use crate::serve::sources::osc::OscDemux;
 use crate::serve::sources::InputCounters;
 use harness::{through_daemon, through_relay, Run};
+use server_outputs::ServerOutput;
 
 const MARKERS: usize = 109;
 const COMPONENTS: usize = 20;
@@ -70,8 +74,14 @@ pub(crate) fn run(args: &BenchArgs) -> Result<()> {
             print_natnet(nn, how, (&r.daemon, &r.relay), k)?;
         }
     }
-    if let Some((osc, natnet)) = &r.natnet_server {
-        print_natnet_server(osc, natnet, k)?;
+    for (server, name) in r
+        .servers
+        .iter()
+        .zip(["natnet server (unicast 4.1)", "qtm server (tcp)"])
+    {
+        if let Some((osc, seen)) = server {
+            print_server_output(osc, seen, k, name)?;
+        }
     }
     if let Some(watched) = &r.watched {
         print_watched(&r.daemon, watched, k)?;
@@ -94,8 +104,9 @@ struct Measured {
     watched: Option<Run>,
     /// The daemon fed over NatNet, multicast and unicast, every round.
     over_natnet: [Option<Run>; 2],
-    /// The daemon with a NatNet server client beside the OSC receivers, every round.
-    natnet_server: Option<(Run, harness::Seen)>,
+    /// The daemon with a NatNet server client, and with a QTM server client, beside the OSC
+    /// receivers, every round.
+    servers: [Option<(Run, harness::Seen)>; 2],
     /// The daemon at the maximum rate.
     max: Run,
 }
@@ -111,17 +122,16 @@ async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
     let mut relay = through_relay(model, n, k, per_round).await?;
     let mut watched: Option<Run> = None;
     let mut over_natnet: [Option<Run>; 2] = [None, None];
-    let mut natnet_server: Option<(Run, harness::Seen)> = None;
+    let mut servers: [Option<(Run, harness::Seen)>; 2] = [None, None];
+    let outputs = [
+        (ServerOutput::NatNet, args.natnet_server),
+        (ServerOutput::Qtm, args.qtm_server),
+    ];
     for round in 0..rounds {
-        if args.natnet_server {
-            let (osc, nn) =
-                natnet_server::through_daemon_natnet_server(model, (n, k), per_round, w).await?;
-            match natnet_server.as_mut() {
-                None => natnet_server = Some((osc, nn)),
-                Some(all) => {
-                    all.0.add(osc);
-                    all.1.add(&nn);
-                }
+        for ((output, asked), all) in outputs.into_iter().zip(servers.iter_mut()) {
+            if asked {
+                let r = server_outputs::through_daemon_server(model, (n, k), per_round, w, output);
+                add_pair(all, r.await?);
             }
         }
         for (multicast, all) in [true, false].into_iter().zip(over_natnet.iter_mut()) {
@@ -153,7 +163,7 @@ async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
         relay,
         watched,
         over_natnet,
-        natnet_server,
+        servers,
         max,
     })
 }
@@ -225,22 +235,32 @@ fn print_natnet(
     Ok(())
 }
 
-/// The NatNet server's client against the OSC compact receivers of the same runs.
-fn print_natnet_server(osc: &Run, natnet: &harness::Seen, clients: usize) -> Result<()> {
+/// Adds a round's OSC run and server client to the rounds before.
+fn add_pair(all: &mut Option<(Run, harness::Seen)>, (osc, seen): (Run, harness::Seen)) {
+    match all.as_mut() {
+        None => *all = Some((osc, seen)),
+        Some(all) => {
+            all.0.add(osc);
+            all.1.add(&seen);
+        }
+    }
+}
+
+/// A server output's client against the OSC compact receivers of the same runs.
+fn print_server_output(osc: &Run, seen: &harness::Seen, clients: usize, name: &str) -> Result<()> {
     crate::out!(
-        "natnet server (unicast 4.1, beside {clients} OSC compact receivers): {} of {} frames \
-         received; osc {} of ~{}",
-        natnet.received,
+        "{name}, beside {clients} OSC compact receivers: {} of {} frames received; osc {} of ~{}",
+        seen.received,
         osc.sent,
         osc.seen.received,
         osc.sent * clients as u64,
     );
     for (label, q) in [("p50", 0.5), ("p99", 0.99), ("p99.9", 0.999), ("max", 1.0)] {
-        let n = natnet.latency_us.value_at_quantile(q);
+        let n = seen.latency_us.value_at_quantile(q);
         let o = osc.seen.latency_us.value_at_quantile(q);
         crate::out!(
-            "{label} added latency of the natnet server output: {n} µs (osc compact, same run, \
-             {o} µs, ratio {:.2}x)",
+            "{label} added latency of the {name} output: {n} µs (osc compact, same run, {o} µs, \
+             ratio {:.2}x)",
             n as f64 / o.max(1) as f64
         );
     }

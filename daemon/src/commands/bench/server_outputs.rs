@@ -1,8 +1,9 @@
-//! The bench's NatNet server mode (`emoshift bench --natnet-server`): the same paced OSC
-//! performers through the daemon, with one NatNet client (unicast, bitstream 4.1) on its
-//! `--natnet-server` beside the OSC compact receivers, in the same run. The NatNet frame keeps
-//! the source's capture time (the send time on the bench's clock) as its timestamp, so the
-//! client times the same path end to end as the OSC receivers do.
+//! The bench's server-output modes (`emoshift bench --natnet-server`, `--qtm-server`): the same
+//! paced OSC performers through the daemon, with one client on its NatNet server (unicast,
+//! bitstream 4.1) or its QTM server (TCP, `StreamFrames AllFrames 3D`) beside the OSC compact
+//! receivers, in the same run. Both outputs keep the source's capture time (the send time on
+//! the bench's clock) as the frame's timestamp, so the client times the same path end to end
+//! as the OSC receivers do.
 
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -17,31 +18,67 @@ use protocol::natnet::{
 };
 
 use super::harness::{collect, daemon_config, epoch, receivers, send_all, Run, Seen};
+use super::qtm_client::QtmClient;
 use super::MARKERS;
 use crate::loopback::{ControlClient, Daemon};
 use crate::serve::stats::Stats;
 
+/// The server output a round's client reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum ServerOutput {
+    /// `--natnet-server`, unicast 4.1.
+    NatNet,
+    /// `--qtm-server`, TCP.
+    Qtm,
+}
+
+/// The client's thread, started on `daemon`'s server `output`.
+fn start_client(
+    daemon: &Daemon,
+    output: ServerOutput,
+    stop: &Arc<AtomicBool>,
+) -> Result<std::thread::JoinHandle<Seen>> {
+    let stop = Arc::clone(stop);
+    Ok(match output {
+        ServerOutput::NatNet => {
+            let server = daemon.natnet_server.context("the daemon serves NatNet")?;
+            let client = NatNetClient::connect(server)?;
+            std::thread::spawn(move || client.run(&stop))
+        }
+        ServerOutput::Qtm => {
+            let server = daemon.qtm_server.context("the daemon serves QTM")?;
+            let client = QtmClient::connect(server)?;
+            std::thread::spawn(move || client.run(&stop))
+        }
+    })
+}
+
 /// Keep-alives this often (NatNetLib sends one a second).
 const KEEP_ALIVE_EVERY: Duration = Duration::from_millis(500);
 
-/// One paced round: the OSC receivers' run, and what the NatNet client saw.
-pub(super) async fn through_daemon_natnet_server(
+/// One paced round: the OSC receivers' run, and what the client of `output` saw.
+pub(super) async fn through_daemon_server(
     model: &IcaModel,
     (performers, clients): (usize, usize),
     secs: Duration,
     poll_window_us: u64,
+    output: ServerOutput,
 ) -> Result<(Run, Seen)> {
     let (receivers, addrs) = receivers(clients).await?;
     let mut raw = daemon_config(&addrs, poll_window_us);
-    raw.natnet_server = Some("127.0.0.1:0".into());
+    match output {
+        ServerOutput::NatNet => raw.natnet_server = Some("127.0.0.1:0".into()),
+        ServerOutput::Qtm => {
+            raw.qtm_server = Some("127.0.0.1:0".into());
+            raw.qtm_server_discovery = Some("off".into());
+        }
+    }
     let daemon = Daemon::start_with(raw.validate()?, model.clone()).await?;
-    let server = daemon.natnet_server.context("the daemon serves NatNet")?;
     let stop = Arc::new(AtomicBool::new(false));
-    let client = NatNetClient::connect(server)?;
-    let stop2 = Arc::clone(&stop);
-    let thread = std::thread::spawn(move || client.run(&stop2));
+    let thread = start_client(&daemon, output, &stop)?;
     let traffic = async {
-        // The client's first keep-alive makes it a receiver; a moment for it to land.
+        // The client's first keep-alive (NatNet) or stream request (QTM) makes it a receiver;
+        // a moment for it to land.
         tokio::time::sleep(Duration::from_millis(50)).await;
         let sent = send_all(model, performers, daemon.frames, 120.0, secs).await?;
         tokio::time::sleep(Duration::from_millis(200)).await;
@@ -51,17 +88,17 @@ pub(super) async fn through_daemon_natnet_server(
     .await;
     stop.store(true, Ordering::Relaxed);
     daemon.stop(Duration::from_secs(5)).await?;
-    let natnet = tokio::task::spawn_blocking(move || thread.join())
+    let client = tokio::task::spawn_blocking(move || thread.join())
         .await
-        .context("joining the NatNet client")?
-        .map_err(|_| anyhow::anyhow!("the NatNet client panicked"))?;
+        .context("joining the server output's client")?
+        .map_err(|_| anyhow::anyhow!("the server output's client panicked"))?;
     let (sent, status) = traffic?;
     let run = Run {
         seen: collect(receivers).await,
         sent,
         status,
     };
-    Ok((run, natnet))
+    Ok((run, client))
 }
 
 /// A minimal unicast NatNet client: connect, keep-alives, frames timed from their timestamp.
