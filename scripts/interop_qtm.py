@@ -14,6 +14,17 @@ Chain: that server (fed by replay, proven above) is the QTM stand-in. `emoshift 
 from it writes the frames it served; `serve --qtm` takes them live, edits them and serves them
 again through its own `--qtm-server` to qtm-rt, QTM's frame numbers kept.
 
+Timecode chain: scripts/qtm_stand_in.py serves the take stamped SMPTE, then IRIG (accepted
+first by qtm-rt: frames, positions and timecode as served); `serve --qtm` from it serves them
+on through `--qtm-server`, and qtm-rt there reads each frame's timecode as the stand-in sent
+it, SMPTE and IRIG; the OSC output carries the SMPTE frames' timecode and none for IRIG.
+
+Discovery: in the private network namespace interop-qtm makes, a veth pair with a default
+route makes 255.255.255.255 reachable; `serve --qtm-server 0.0.0.0:PORT` answers qtm-rt's
+`Discover` with QTM's base port (PORT - 1) from the namespace's address. Without root (no
+namespace) or without veth it prints SKIP with the reason; it never binds beyond loopback on
+the host.
+
 Prints PASS/FAIL per check and "N passed, M failed"; exit status 1 on any failure.
 """
 
@@ -31,6 +42,8 @@ import time
 
 import qtm_rt
 from qtm_rt.packet import QRTComponentType, QRTEvent, QRTPacket
+
+from qtm_stand_in import StandIn, same_positions, tc_of
 
 EMOSHIFT = os.environ["EMOSHIFT"]
 results = []
@@ -111,7 +124,7 @@ def take(work):
 class Daemon:
     """`emoshift serve --qtm-server`, its OSC compact output collected."""
 
-    def __init__(self, work, model, extra=()):
+    def __init__(self, work, model, extra=(), qtm_ip="127.0.0.1"):
         self.rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.rx.bind(("127.0.0.1", 0))
         self.listen, self.control = free_port(), free_port()
@@ -120,7 +133,7 @@ class Daemon:
             [EMOSHIFT, "serve", "--model", model,
              "--listen", f"127.0.0.1:{self.listen}", "--control", f"127.0.0.1:{self.control}",
              "--send", f"127.0.0.1:{self.rx.getsockname()[1]}",
-             "--qtm-server", f"127.0.0.1:{self.qtm}"] + list(extra),
+             "--qtm-server", f"{qtm_ip}:{self.qtm}"] + list(extra),
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         self.got, self.stop = [], threading.Event()
         threading.Thread(target=collect, args=(self.rx, self.got, self.stop), daemon=True).start()
@@ -343,10 +356,159 @@ def chain(work):
             len(next(iter(got.values()))) if got else 0)
 
 
+async def stream_timecodes(port, start=None, seconds_idle=1.5):
+    """qtm-rt streams 3D and Timecode over TCP from `port` (then `start()`s the source) until
+    frames stop: {frame number: (flat positions, (type, hi, lo) or None)}."""
+    conn = await qtm_rt.connect("127.0.0.1", port=port, version="1.25")
+    if conn is None:
+        return None
+    got, last = {}, [time.time()]
+
+    def on_packet(p):
+        _, markers = p.get_3d_markers()
+        got[p.framenumber] = ([c for m in markers for c in (m.x, m.y, m.z)], tc_of(p))
+        last[0] = time.time()
+    streaming = asyncio.ensure_future(
+        conn.stream_frames(frames="allframes", components=["3d", "timecode"],
+                           on_packet=on_packet))
+    await asyncio.sleep(0.3)
+    if start:
+        start()
+    await streaming
+    while time.time() - last[0] < seconds_idle:
+        await asyncio.sleep(0.1)
+    await conn.stream_frames_stop()
+    conn.disconnect()
+    return got
+
+
+def osc_timecodes(datagrams):
+    """{frame number: /mocap/timecode (packed, sub, num, den, flags) or None} of the compact
+    output."""
+    out = {}
+    for d in datagrams:
+        msgs = osc_messages(d)
+        tc = next((struct.unpack(">IIIIi", a) for n, t, a in msgs if n == "/mocap/timecode"),
+                  None)
+        for addr, tags, args in msgs:
+            if addr == "/mocap/frame":
+                out[struct.unpack_from(">i", args, 0)[0]] = tc
+    return out
+
+
+def check_timecodes(what, served, got, wanted):
+    """Every frame `got` has the stand-in's timecode; enough of both kinds arrive."""
+    wrong = [n for n, (_, tc) in got.items() if n not in served or tc != served[n][1]]
+    kinds = {k: sum(1 for n, (_, tc) in got.items() if tc and tc[0] == k) for k in (0, 1)}
+    check(f"{what}: every frame's timecode is the stand-in's ({kinds[0]} SMPTE, "
+          f"{kinds[1]} IRIG)", got and not wrong and min(kinds.values()) > 0.3 * wanted,
+          (len(got), wrong[:5], kinds))
+
+
+async def timecode_chain_async(work, labels, frames):
+    stand_in = StandIn(labels, frames)
+    port = await stand_in.start()
+    stand_in.go.set()
+    direct = await stream_timecodes(port)
+    check("stand-in: qtm-rt streams every frame it serves",
+          direct is not None and sorted(direct) == sorted(stand_in.served),
+          (len(direct or {}), len(stand_in.served)))
+    check("stand-in: positions as served",
+          direct and all(same_positions(p, stand_in.served[n][0]) for n, (p, _) in direct.items()))
+    check_timecodes("stand-in (qtm-rt)", stand_in.served, direct or {}, len(frames) // 2)
+    stand_in.go.clear()
+    daemon = Daemon(work, f"{work}/model.json", ["--qtm", f"127.0.0.1:{port}"])
+    try:
+        got = await stream_timecodes(daemon.qtm, start=stand_in.go.set)
+    finally:
+        code, err = daemon.close()
+        stand_in.close()
+    check("timecode chain: serve --qtm stops cleanly", code == 0, err[-400:])
+    check_timecodes("timecode chain (stand-in -> serve --qtm -> --qtm-server -> qtm-rt)",
+                    stand_in.served, got or {}, len(frames) // 2)
+    osc = osc_timecodes(daemon.got)
+    bad = []
+    for n, tc in osc.items():
+        kind, _, lo = stand_in.served[n][1]
+        want = None if kind == 1 else (
+            (lo & 0x1f) << 24 | (lo >> 5 & 0x3f) << 16 | (lo >> 11 & 0x3f) << 8 | lo >> 17 & 0x1f,
+            lo >> 22 & 0x1ff)
+        if (tc[:2] if tc and tc[4] & 1 else None) != want:
+            bad.append((n, tc, want))
+    check(f"timecode chain: the OSC output says SMPTE as SMPTE and nothing for IRIG "
+          f"({len(osc)} frames)", len(osc) > 100 and not bad, bad[:3])
+
+
+def timecode_chain(work):
+    src = f"{work}/session/s01_neutral.csv"
+    header = next(ln for ln in open(src) if ln.startswith("frame,"))
+    labels = [c[:-2] for c in header.strip().split(",")[2::3]]
+    rows = read_csv(src)
+    frames = [rows[n] for n in sorted(rows)][:360]
+    asyncio.run(timecode_chain_async(work, labels, frames))
+
+
+VETH = [["link", "add", "qtmd0", "type", "veth", "peer", "name", "qtmd1"],
+        ["addr", "add", "10.77.0.1/24", "dev", "qtmd0"],
+        ["addr", "add", "10.77.0.2/24", "dev", "qtmd1"],
+        ["link", "set", "qtmd0", "up"], ["link", "set", "qtmd1", "up"],
+        ["route", "add", "default", "dev", "qtmd0"]]
+
+
+def broadcast_net():
+    """In the private namespace interop-qtm made: a veth pair and a default route, so that
+    255.255.255.255 is reachable. None when it works, else why not (the command, its error)."""
+    if os.environ.get("EMOSHIFT_PRIVATE_NETNS") != "1":
+        return "not in a private network namespace (interop-qtm needs root for unshare --net)"
+    for args in VETH:
+        r = subprocess.run(["ip"] + args, capture_output=True, text=True)
+        if r.returncode != 0:
+            return f"`ip {' '.join(args)}`: {r.stderr.strip()}"
+    return None
+
+
+async def discover_all():
+    return [r async for r in qtm_rt.Discover("0.0.0.0")]
+
+
+def discovery(work):
+    """qtm-rt's Discover broadcasts to 255.255.255.255:22226 and finds `serve --qtm-server
+    0.0.0.0:PORT` with QTM's base port (PORT - 1) from the namespace's own address."""
+    why = broadcast_net()
+    if why:
+        print(f"SKIP discovery (no broadcast network here): {why}", flush=True)
+        return
+    daemon = Daemon(work, f"{work}/model.json", ["--control-allow", "127.0.0.0/8,10.77.0.0/24"],
+                    qtm_ip="0.0.0.0")
+    port = daemon.qtm
+    try:
+        found = asyncio.run(discover_all())
+
+        async def connect(host, base):
+            conn = await qtm_rt.connect(host, port=base + 1, version="1.25")
+            ok = conn is not None and (await conn.qtm_version()).startswith(b"QTM Version is")
+            if conn is not None:
+                conn.disconnect()
+            return ok
+        ours = [r for r in found if r.info.startswith(b"emoshift ")]
+        check("discovery: qtm-rt's Discover finds emoshift once", len(ours) == 1, found)
+        if ours:
+            r = ours[0]
+            check("discovery: QTM's base port (the RT port - 1) and the namespace's address",
+                  r.port == port - 1 and r.host in ("10.77.0.1", "10.77.0.2"), r)
+            check("discovery: qtm-rt connects to the base port + 1 at the discovered host",
+                  asyncio.run(connect(r.host, r.port)))
+    finally:
+        code, err = daemon.close()
+    check("discovery: serve stops cleanly", code == 0, err[-400:])
+
+
 def main():
     with tempfile.TemporaryDirectory() as work:
         output(work)
         chain(work)
+        timecode_chain(work)
+        discovery(work)
     passed = sum(results)
     print(f"{passed} passed, {len(results) - passed} failed")
     sys.exit(0 if passed == len(results) else 1)
