@@ -6,7 +6,7 @@
 //! The page is held to serve's monitor rules with serve's code: `monitor::access` (loopback
 //! by default, a token beyond it, Host and Origin checked) and `monitor::http::gate`. A press
 //! is posted to `/control` as the OSC message the control socket takes (the page encodes it
-//! with serve's `osc.js`) and goes through the same [`super::osc::admit`]: serve's `Guard`,
+//! with serve's `osc.js`) and goes through the same `admit` as the OSC socket: serve's `Guard`,
 //! the allow-list by the page's address, the secret as the last argument. The answer says why
 //! a press was refused, and the page shows it.
 
