@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""The monitor page in a real browser (run by scripts/browser-check, which starts the daemon).
+"""The monitor page in a real browser (run by scripts/browser-check, which starts the daemon),
+then the calibration session's performer page (this script starts `emoshift session`).
 
 Environment: BIN (emoshift), WORK (folder with model.json and session/), OUT (screenshots),
 URL (the page with its token, as `emoshift serve` printed it), FRAMES and CONTROL (the daemon's
@@ -327,6 +328,174 @@ def phone(driver):
     driver.save_screenshot(f"{OUT}/monitor-phone-health.png")
 
 
+# --- the calibration session's performer page ----------------------------------------------
+
+SECRET = "stage-secret-1"
+SCRIPT = """emotions = ["neutral", "happy"]
+[[sentence]]
+text = "The birch canoe slid on the smooth planks."
+seconds = [0.5, 60.0]
+[[sentence]]
+text = "Glue the sheet to the dark blue background."
+seconds = [0.5, 60.0]
+"""
+
+
+def free_udp():
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+class Session:
+    """`emoshift session` fed by a looping replay, its page at `page_ip`, until `close`."""
+
+    def __init__(self, name, page_ip, *extra):
+        self.dir = f"{WORK}/{name}"
+        with open(f"{WORK}/{name}-script.toml", "w") as f:
+            f.write(SCRIPT)
+        frames, self.control = free_udp(), ("127.0.0.1", free_udp())
+        self.log = open(f"{WORK}/{name}.out", "w+")
+        self.proc = subprocess.Popen(
+            [BIN, "session", self.dir, "--listen", f"127.0.0.1:{frames}", "--no-keyboard",
+             "--script", f"{WORK}/{name}-script.toml", "--control", f"127.0.0.1:{self.control[1]}",
+             "--monitor", f"{page_ip}:0", *extra],
+            stdout=self.log, stderr=subprocess.DEVNULL)
+        self.replay = subprocess.Popen([BIN, "replay", f"{WORK}/session/s01_neutral.c3d", "--to",
+                                        f"127.0.0.1:{frames}", "--loop"],
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.url = wait_for(self.page_url, 15)
+
+    def page_url(self):
+        self.log.seek(0)
+        for line in self.log.read().splitlines():
+            if line.startswith("performer view: "):
+                return line.split(": ", 1)[1]
+        return None
+
+    def status(self):
+        """The session's /session/status: (take, takes, sentence, emotion, state, text)."""
+        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        s.bind(("127.0.0.1", 0))
+        s.settimeout(3)
+        try:
+            s.sendto(osc("/session/status"), self.control)
+            return parse_message(s.recv(65536))[1]
+        finally:
+            s.close()
+
+    def close(self):
+        for p in (self.replay, self.proc):
+            p.terminate()
+            try:
+                p.wait(10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+        self.log.close()
+
+
+PAGE_STATE = """const v = window.emoshiftSession && window.emoshiftSession.last();
+if (!v) return null;
+const shown = [...document.querySelectorAll('#controls button')].filter(b => !b.hidden).map(b => b.id);
+return {take: v.take, state: v.state, emotion: document.getElementById('emotion').textContent,
+        text: document.getElementById('text').textContent, why: document.getElementById('why').textContent,
+        light: document.getElementById('light').className, shown};"""
+
+
+def post_control(origin, cookie, url):
+    """The status of a /control post of /session/start from `origin` (with the cookie or not)."""
+    page = urllib.parse.urlsplit(url)
+    token = urllib.parse.parse_qs(page.query).get("token", [""])[0]
+    conn = http.client.HTTPConnection(page.hostname, page.port, timeout=5)
+    headers = {"Origin": origin, "Content-Type": "application/octet-stream"}
+    if cookie:
+        headers["Cookie"] = f"emoshift_monitor={token}"
+    conn.request("POST", "/control", body=osc("/session/start", SECRET), headers=headers)
+    code = conn.getresponse().status
+    conn.close()
+    return code
+
+
+def session_page(driver):
+    """The prompt, presses that start and stop takes, the page advancing, refusals shown."""
+    driver.set_window_size(1440, 1000)
+    sess = Session("perf", "127.0.0.2", "--control-secret", SECRET)
+    try:
+        check("the session prints its performer page with a token", sess.url and "token=" in sess.url,
+              sess.url)
+        base = urllib.parse.urlsplit(sess.url)
+        check("the page refuses a press without its token (401)",
+              post_control(f"http://{base.netloc}", False, sess.url) == 401)
+        check("and a press from another site's page, even with the token (403)",
+              post_control("http://evil.example", True, sess.url) == 403)
+        driver.get(f"http://{base.netloc}/?token=wrong-{SECRET}")
+        check("a wrong token gets the login prompt",
+              "not this daemon's" in driver.find_element(By.TAG_NAME, "body").text)
+        driver.get(sess.url)
+        state = lambda: js(driver, PAGE_STATE)
+        st = sess.status()
+        shown = wait_for(lambda: (state() or {}).get("emotion", "").lower() == st[3] and state(), 10)
+        check("the page shows the prompt: the emotion and the sentence, take 1",
+              shown and shown["text"] == st[5] and shown["take"] == 1, (shown, st))
+        check("waiting: start, skip and back shown, stop hidden",
+              shown and {"start", "skip", "back"} <= set(shown["shown"]) and "stop" not in shown["shown"],
+              shown)
+        size = js(driver, "return [parseFloat(getComputedStyle(document.getElementById('text')).fontSize),"
+                          "document.getElementById('start').getBoundingClientRect().height]")
+        check("readable from a few metres: sentence text >= 60 px, buttons >= 100 px tall at 1000 px",
+              size[0] >= 60 and size[1] >= 100, size)
+        driver.find_element(By.ID, "start").click()
+        why = wait_for(lambda: "secret" in (state() or {}).get("why", "") and state()["why"], 5)
+        check("a press without the control secret is refused and the page says why",
+              why and sess.status()[4] == "waiting", why)
+        driver.find_element(By.ID, "secret").send_keys(SECRET)
+        takes(driver, sess, state)
+    finally:
+        sess.close()
+
+
+def takes(driver, sess, state):
+    for n in (1, 2):
+        driver.find_element(By.ID, "start").click()
+        rec = wait_for(lambda: (state() or {}).get("state") == "recording" and state(), 5)
+        check(f"take {n}: the start button records (light on, only stop shown)",
+              rec and rec["light"] == "on" and rec["shown"] == ["stop"] and sess.status()[4] == "recording",
+              rec)
+        time.sleep(1.5)
+        driver.find_element(By.ID, "stop").click()
+        moved = wait_for(lambda: (state() or {}).get("take") == n + 1 and state(), 10)
+        check(f"take {n}: the stop button stops it, it is accepted and the page advances to take {n + 1}",
+              moved and moved["state"] == "waiting" and sess.status()[0] == n, (moved, sess.status()))
+        if n == 1:
+            driver.save_screenshot(f"{OUT}/session-page.png")
+    written = [f for f in os.listdir(sess.dir) if f.endswith(".c3d")]
+    check("both takes are written and listed", len(written) == 2
+          and os.path.exists(f"{sess.dir}/session.toml"), written)
+
+
+def session_refused_peer(driver):
+    """A page whose address the allow-list leaves out is view only and says why."""
+    sess = Session("view-only", "127.0.0.1", "--control-allow", "192.0.2.0/24")
+    try:
+        driver.get(sess.url)
+        state = lambda: js(driver, PAGE_STATE)
+        why = wait_for(lambda: "not allowed" in (state() or {}).get("why", "") and state()["why"], 10)
+        disabled = js(driver, "return [...document.querySelectorAll('#controls button')].every(b => b.disabled)")
+        check("a page from a peer the allow-list refuses is view only and says why", why and disabled, why)
+        answer = js(driver, "const b = new Uint8Array([47,115,101,115,115,105,111,110,47,115,116,97,114,116,0,0,44,0,0,0]);"
+                            "const x = new XMLHttpRequest(); x.open('POST', '/control', false); x.send(b);"
+                            "return JSON.parse(x.responseText);")
+        # (The OSC status is refused to this peer too: the page's own view says the state.)
+        time.sleep(0.5)
+        check("and a press from it is refused with the reason, the take not started",
+              not answer["ok"] and "not allowed" in answer["error"] and state()["state"] == "waiting",
+              (answer, state()))
+    finally:
+        sess.close()
+
+
 def main():
     relay, sub = Relay(), Subscriber()
     relay.start()
@@ -340,7 +509,8 @@ def main():
               wait_for(lambda: sub.confirmed and sub.frames > 10, 10))
         for step in (lambda: refusals(driver), lambda: views(driver), lambda: hover_and_rotate(driver),
                      lambda: control(driver, sub),
-                     lambda: drops(driver, relay), lambda: recording(driver), lambda: phone(driver)):
+                     lambda: drops(driver, relay), lambda: recording(driver), lambda: phone(driver),
+                     lambda: session_page(driver), lambda: session_refused_peer(driver)):
             try:
                 step()
             except Exception as e:  # one broken step must not hide the others' results
@@ -351,7 +521,7 @@ def main():
         replay.wait(5)
         relay.stop = sub.stop = True
     passed = sum(results)
-    print(f"screenshots: {OUT}/monitor-desktop.png, monitor-happy.png, monitor-phone.png")
+    print(f"screenshots: {OUT}/monitor-desktop.png, monitor-happy.png, monitor-phone.png, session-page.png")
     print(f"{passed} passed, {len(results) - passed} failed")
     return 0 if passed == len(results) and results else 1
 

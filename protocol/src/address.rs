@@ -66,6 +66,9 @@ pub const SESSION_SKIP: &str = "/session/skip";
 pub const SESSION_BACK: &str = "/session/back";
 /// Session control: train and analyse what was recorded, no arguments.
 pub const SESSION_FINISH: &str = "/session/finish";
+/// Session control: after a finish that found takes to redo, record just those again now (in
+/// the same sitting), no arguments.
+pub const SESSION_REDO: &str = "/session/redo";
 /// Session control: ask where the session is, no arguments; answered by
 /// `/session/status/confirm ,iiisss` (take index from 0, takes in total, sentence number from
 /// 1, emotion, state, sentence text).
@@ -103,7 +106,7 @@ pub enum Address {
     Confirm,
 }
 
-const CONTROLS: [&str; 21] = [
+const CONTROLS: [&str; 22] = [
     EMOTION_TARGET,
     EMOTION_AMOUNT,
     EMOTION_RAMP,
@@ -124,6 +127,7 @@ const CONTROLS: [&str; 21] = [
     SESSION_SKIP,
     SESSION_BACK,
     SESSION_FINISH,
+    SESSION_REDO,
     SESSION_STATUS,
 ];
 

@@ -249,10 +249,20 @@ pub struct SessionArgs {
     #[arg(long)]
     pub no_keyboard: bool,
     /// Serve the performer's view (the sentence large, the emotion, take n of N, a recording
-    /// light, the markers seen) at this address [default: 127.0.0.1:9080].
+    /// light, the markers seen, and big start/stop/retake/skip/back/finish buttons under the
+    /// control rules) at this address [default: 127.0.0.1:9080].
     #[arg(long, value_name = "IP:PORT", num_args = 0..=1,
           default_missing_value = crate::serve::session::view::DEFAULT_VIEW)]
     pub monitor: Option<String>,
+    /// The token the performer's view asks for (16 to 256 letters, digits or -._~) [default:
+    /// none on this host's own address, a random one printed at start beyond it].
+    #[arg(
+        long,
+        value_name = "TOKEN",
+        env = "EMOSHIFT_MONITOR_TOKEN",
+        hide_env_values = true
+    )]
+    pub monitor_token: Option<String>,
 }
 
 /// `emoshift replay`.

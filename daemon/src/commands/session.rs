@@ -1,9 +1,11 @@
 //! `emoshift session DIR`: a new performer's paired calibration session from a live source
-//! ([`crate::serve::session`]), then, on finish, training and analysis of what was recorded
-//! into `DIR/model.json` and `DIR/report/`, and with `--load-into` the model sent to a running
+//! ([`crate::serve::session`]); on finish, training and analysis of what was recorded into
+//! `DIR/model.json` and `DIR/report/` (the session offers to re-record, there and then, the
+//! takes the analysis says to redo), and with `--load-into` the model sent to a running
 //! `serve`.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use replay::session::Regions;
@@ -16,7 +18,7 @@ use crate::offline::session::script::{Script, DEFAULT_SENTENCES};
 use crate::offline::session::Sitting;
 use crate::serve::allow::AllowList;
 use crate::serve::session::files::{self, MANIFEST, SCRIPT};
-use crate::serve::session::{self as live, Ended, SessionConfig};
+use crate::serve::session::{self as live, Ended, Finisher, SessionConfig};
 
 /// The arguments, checked, and the session folder made ready.
 fn config(args: &SessionArgs) -> Result<SessionConfig> {
@@ -63,6 +65,8 @@ fn config(args: &SessionArgs) -> Result<SessionConfig> {
                     .map_err(|_| UsageError(format!("--monitor: {m:?} is not an IP:PORT address")))
             })
             .transpose()?,
+        monitor_token: crate::serve::config::check_token(args.monitor_token.clone())
+            .map_err(|e| UsageError(format!("--monitor-token: {e}")))?,
     })
 }
 
@@ -86,14 +90,20 @@ fn sitting(args: &SessionArgs) -> Result<Sitting> {
             );
         }
         let manifest = dir.join(MANIFEST);
-        return Ok(match manifest.exists() {
+        let mut sitting = match manifest.exists() {
             true => Sitting::resume(
                 script,
                 &args.format,
                 &crate::offline::load_session(&manifest)?,
             ),
             false => Sitting::new(script, &args.format),
-        });
+        };
+        if !args.redo.is_empty() {
+            sitting
+                .redo(&args.redo)
+                .map_err(|e| UsageError(format!("--{e}")))?;
+        }
+        return Ok(sitting);
     }
     if script_path.exists() || dir.join(MANIFEST).exists() {
         return Err(UsageError(format!(
@@ -146,21 +156,45 @@ pub(crate) fn run(args: &SessionArgs) -> Result<()> {
             // The operator's lines; a closed stdout (piped into a pager that quit) ends none.
             let _ = writeln!(std::io::stdout().lock(), "{line}");
         };
-        live::run(&config, &mut sitting, shutdown, &mut say).await
+        live::run(&config, &mut sitting, finisher(args), shutdown, &mut say).await
     })?;
     if ended == Ended::Interrupted {
         return Ok(());
     }
-    let model = finish(args)?;
     if let Some(to) = &args.load_into {
-        runtime.block_on(load_into(to, &model))?;
+        runtime.block_on(load_into(to, &args.dir.join("model.json")))?;
     }
     Ok(())
 }
 
-/// Trains on the accepted takes into `DIR/model.json` (an older one goes to `replaced/`) and
-/// analyses them into `DIR/report/` when the session has a regions file.
-fn finish(args: &SessionArgs) -> Result<PathBuf> {
+/// What finishing needs of the arguments.
+struct Finishing {
+    dir: PathBuf,
+    format: String,
+    /// The source's flag, for the printed `--resume --redo` command.
+    source: String,
+}
+
+/// The session's finish: [`finish`], then what to redo.
+fn finisher(args: &SessionArgs) -> Finisher {
+    let source = match (&args.listen, &args.natnet, &args.qtm) {
+        (Some(l), _, _) => format!("--listen {l}"),
+        (_, Some(n), _) => format!("--natnet {n}"),
+        (_, _, Some(q)) => format!("--qtm {q}"),
+        _ => String::new(),
+    };
+    let f = Finishing {
+        dir: args.dir.clone(),
+        format: args.format.clone(),
+        source,
+    };
+    Arc::new(move || finish(&f))
+}
+
+/// Trains on the accepted takes into `DIR/model.json` (an older one goes to `replaced/`),
+/// analyses them into `DIR/report/` when the session has a regions file, and says what to
+/// redo.
+fn finish(args: &Finishing) -> Result<Advice> {
     let dir = args.dir.as_path();
     let manifest = dir.join(MANIFEST);
     let session = crate::offline::load_session(&manifest)?;
@@ -184,7 +218,7 @@ fn finish(args: &SessionArgs) -> Result<PathBuf> {
              space); add one (--regions FILE with --resume, then finish) to analyse",
             dir.display()
         );
-        return Ok(model_path);
+        return Ok(Advice::default());
     }
     crate::out!("analysing ...");
     let report = super::analyze::Report {
@@ -193,12 +227,13 @@ fn finish(args: &SessionArgs) -> Result<PathBuf> {
         axes: crate::offline::analysis::Axes::default(),
     };
     let (_, report) = super::analyze::analyze_and_write(&model_path, &manifest, None, &report)?;
-    tell_advice(args, &advise(&report))?;
-    Ok(model_path)
+    let advice = advise(&report);
+    tell_advice(args, &advice)?;
+    Ok(advice)
 }
 
-/// What to redo, and the command that records just those takes again.
-fn tell_advice(args: &SessionArgs, advice: &Advice) -> Result<()> {
+/// What to redo, and the command that records just those takes again in a later sitting.
+fn tell_advice(args: &Finishing, advice: &Advice) -> Result<()> {
     if advice.lines.is_empty() {
         crate::out!("nothing to redo: every emotion stands apart and no take is an outlier");
         return Ok(());
@@ -208,18 +243,14 @@ fn tell_advice(args: &SessionArgs, advice: &Advice) -> Result<()> {
         crate::out!("  - {line}");
     }
     if !advice.redo.is_empty() {
-        let source = match (&args.listen, &args.natnet) {
-            (Some(l), _) => format!("--listen {l}"),
-            (_, Some(n)) => format!("--natnet {n}"),
-            _ => String::new(),
-        };
+        let source = &args.source;
         let takes: Vec<&str> = advice
             .redo
             .iter()
             .map(|f| f.trim_end_matches(&format!(".{}", args.format)))
             .collect();
         crate::out!(
-            "re-record just those takes, then finish again: emoshift session {} {source} --resume --redo {}",
+            "in a later sitting: emoshift session {} {source} --resume --redo {}",
             args.dir.display(),
             takes.join(",")
         );

@@ -140,8 +140,11 @@ pub enum SessionControl {
     Skip,
     /// `/session/back`: go back one take.
     Back,
-    /// `/session/finish`: train and analyse.
+    /// `/session/finish`: train and analyse (after a finish that offered a redo: end the
+    /// session with the model as it is).
     Finish,
+    /// `/session/redo`: record again, now, the takes the last finish said to redo.
+    Redo,
     /// `/session/status`: answered with `/session/status/confirm ,iiisss` (see
     /// [`crate::encode_session_status_into`]).
     Status,
@@ -149,13 +152,14 @@ pub enum SessionControl {
 
 impl SessionControl {
     /// Every session control.
-    pub const ALL: [SessionControl; 7] = [
+    pub const ALL: [SessionControl; 8] = [
         SessionControl::Start,
         SessionControl::Stop,
         SessionControl::Retake,
         SessionControl::Skip,
         SessionControl::Back,
         SessionControl::Finish,
+        SessionControl::Redo,
         SessionControl::Status,
     ];
 
@@ -168,6 +172,7 @@ impl SessionControl {
             SessionControl::Skip => a::SESSION_SKIP,
             SessionControl::Back => a::SESSION_BACK,
             SessionControl::Finish => a::SESSION_FINISH,
+            SessionControl::Redo => a::SESSION_REDO,
             SessionControl::Status => a::SESSION_STATUS,
         }
     }

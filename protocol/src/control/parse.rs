@@ -305,7 +305,7 @@ pub(crate) fn parse_control(address: &str, args: Vec<OscType>) -> Result<Control
 }
 
 /// Control addresses and the type tags each takes (for error messages).
-const CONTROL_SHAPES: [(&str, &str); 21] = [
+const CONTROL_SHAPES: [(&str, &str); 22] = [
     (a::EMOTION_TARGET, ",s"),
     (a::EMOTION_AMOUNT, ",f"),
     (a::EMOTION_RAMP, ",f"),
@@ -326,5 +326,6 @@ const CONTROL_SHAPES: [(&str, &str); 21] = [
     (a::SESSION_SKIP, ","),
     (a::SESSION_BACK, ","),
     (a::SESSION_FINISH, ","),
+    (a::SESSION_REDO, ","),
     (a::SESSION_STATUS, ","),
 ];

@@ -2,9 +2,11 @@
 //! prompt the performer replays, into the session's OSC source, the matching take of a
 //! synthetic paired session (sentence k in emotion e), then stops. Along the way a take with
 //! most markers missing is refused and retaken, and the process is killed mid-take and
-//! resumed. The written session then trains and analyses to the same roles and emotion
-//! space as the synthetic session's own manifest. The same through the NatNet source, from
-//! the Motive stand-in.
+//! resumed. Over OSC one take is deliberately played in the wrong emotion: the finish says to
+//! redo it, the session offers it, `/session/redo` records it again in the same sitting, and
+//! the second finish trains on it. The written session then trains and analyses to the same
+//! roles and emotion space as the synthetic session's own manifest. The same through the
+//! NatNet source, from the Motive stand-in.
 
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -22,6 +24,22 @@ use super::support::*;
 const GAPPY_TAKE: i32 = 2;
 /// The take the process is killed in, then offered again after `--resume`.
 const KILLED_TAKE: i32 = 5;
+/// The take played in the wrong emotion (over OSC), which the finish offers to redo.
+const BAD_TAKE: i32 = 9;
+const EMOTIONS: [&str; 4] = ["neutral", "happy", "sad", "angry"];
+
+/// What the scripted performer has done so far.
+#[derive(Default)]
+struct Plan {
+    /// The next frame number.
+    frame: i32,
+    gappy_done: bool,
+    killed: bool,
+    /// Play [`BAD_TAKE`] in the wrong emotion (once); the file it stands for once played.
+    bad: Option<Option<String>>,
+    /// Time spent waiting for the kill and the restart.
+    waited: Duration,
+}
 
 fn emoshift(args: &[&str]) {
     let out = Command::new(env!("CARGO_BIN_EXE_emoshift-e2e"))
@@ -243,17 +261,18 @@ fn sigkill(child: &mut Child) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn issue_33_a_scripted_performer_records_a_session_that_trains_like_its_source() {
-    scripted_session(|_| Feed::Osc(free_port())).await;
+    scripted_session(|_| Feed::Osc(free_port()), true).await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn issue_33_the_same_session_through_natnet_from_the_motive_stand_in() {
-    scripted_session(Feed::natnet).await;
+    scripted_session(Feed::natnet, false).await;
 }
 
 /// Writes a synthetic 8 x 4 session, records it through `emoshift session` fed by `feed`
-/// (given the markers' names), and checks what it trains to.
-async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed) {
+/// (given the markers' names), with one take in the wrong emotion when `bad`, and checks what
+/// it trains to.
+async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed, bad: bool) {
     let tmp = tempfile::tempdir().expect("temp dir");
     let synth = tmp.path().join("synth");
     let s = synth.to_str().expect("utf-8");
@@ -271,21 +290,50 @@ async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed) {
     let control =
         ControlClient::new(format!("127.0.0.1:{}", cp.control).parse().expect("addr")).await;
     let started = Instant::now();
-    let waited = performer(&mut feed, &control, &synth, &dir, &mut child, cp).await;
+    let mut plan = Plan {
+        bad: bad.then_some(None),
+        ..Plan::default()
+    };
+    performer(
+        &mut feed,
+        &control,
+        (&synth, &dir),
+        &mut child,
+        cp,
+        &mut plan,
+    )
+    .await;
+    assert!(plan.gappy_done && plan.killed);
     let recorded = started.elapsed();
     let finish_at = Instant::now();
     assert!(matches!(
         send(&control, SessionControl::Finish).await,
         Reply::Confirm(_)
     ));
+    if let Some(Some(bad_file)) = plan.bad.clone() {
+        redo_offered(
+            &mut feed,
+            &control,
+            (&synth, &dir),
+            &mut child,
+            cp,
+            &mut plan,
+            &bad_file,
+        )
+        .await;
+    }
     let status = wait(&mut child, Duration::from_secs(300));
     assert!(status.success(), "session finished with {status}");
     let finish = finish_at.elapsed();
     eprintln!(
-        "issue 33: 32 takes recorded in {:.1} s (of them {:.1} s waits for the kill and the restart), trained and analysed in {:.1} s",
+        "issue 33: 32 takes recorded in {:.1} s (of them {:.1} s waits for the kill and the restart), trained and analysed in {:.1} s{}",
         recorded.as_secs_f64(),
-        waited.as_secs_f64(),
-        finish.as_secs_f64()
+        plan.waited.as_secs_f64(),
+        finish.as_secs_f64(),
+        match plan.bad {
+            Some(_) => " (twice, with the offered redo between)",
+            None => "",
+        }
     );
     let m = synth.join("session.toml");
     let (m, model) = (m.to_str().expect("utf-8"), format!("{s}/model.json"));
@@ -303,12 +351,17 @@ async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed) {
     ]);
     same_roles_and_space(&trained(&dir), &trained(&synth));
     let said = std::fs::read_to_string(dir.with_extension("log")).expect("the session's log");
+    let offered = ["to redo:", "(or /session/redo", "--resume --redo"];
+    let offered = offered.iter().filter(|_| plan.bad.is_some());
     for line in [
         "REFUSED: only",
         "kept as",
         "nothing to redo",
         "roles and levels written",
-    ] {
+    ]
+    .iter()
+    .chain(offered)
+    {
         assert!(
             said.contains(line),
             "the session never said {line:?}:\n{said}"
@@ -319,19 +372,77 @@ async fn scripted_session(feed: impl FnOnce(&[String]) -> Feed) {
     }
 }
 
+/// After the first finish: the bad take is offered (on the page), `/session/redo` prompts it,
+/// it is played right, and a second finish trains; the old take is kept in `replaced/`.
+async fn redo_offered(
+    feed: &mut Feed,
+    control: &ControlClient,
+    (synth, dir): (&Path, &Path),
+    child: &mut Child,
+    cp: Ports,
+    plan: &mut Plan,
+    bad_file: &str,
+) {
+    let until = Instant::now() + Duration::from_secs(240);
+    let offered = loop {
+        if let Some(s) = child.try_wait().expect("waits") {
+            panic!("the session ended ({s}) without offering to redo {bad_file}");
+        }
+        let v = view(cp.view);
+        let offered: Vec<String> = v["offered"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|f| f.as_str().map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default();
+        if !offered.is_empty() {
+            assert!(!v["advice"].as_array().expect("advice").is_empty(), "{v}");
+            break offered;
+        }
+        assert!(Instant::now() < until, "no redo offered: {v}");
+        tokio::time::sleep(Duration::from_millis(250)).await;
+    };
+    assert!(
+        offered.iter().any(|f| f == bad_file),
+        "the take played in the wrong emotion is not offered: {offered:?}"
+    );
+    assert!(matches!(
+        send(control, SessionControl::Redo).await,
+        Reply::Confirm(_)
+    ));
+    let st = status(control).await;
+    assert_eq!(st.state, "waiting", "{st:?}");
+    performer(feed, control, (synth, dir), child, cp, plan).await;
+    assert!(
+        dir.join("replaced").join(bad_file).exists(),
+        "the replaced take is kept"
+    );
+    assert!(matches!(
+        send(control, SessionControl::Finish).await,
+        Reply::Confirm(_)
+    ));
+}
+
 /// Plays every prompted take until the session is done, refusing one with most markers
-/// missing and killing the process in another; returns the time spent waiting for the kill
-/// and the restart.
+/// missing, killing the process in another, and playing [`BAD_TAKE`] in the wrong emotion
+/// when the plan says so.
 async fn performer(
     feed: &mut Feed,
     control: &ControlClient,
-    synth: &Path,
-    dir: &Path,
+    (synth, dir): (&Path, &Path),
     child: &mut Child,
     cp: Ports,
-) -> Duration {
-    let (mut frame, mut gappy_done, mut killed) = (0i32, false, false);
-    let mut waited = Duration::ZERO;
+    plan: &mut Plan,
+) {
+    let Plan {
+        frame,
+        gappy_done,
+        killed,
+        bad,
+        waited,
+    } = plan;
     loop {
         let st = status(control).await;
         if st.state == "done" {
@@ -348,16 +459,23 @@ async fn performer(
             assert_eq!(v["state"], "waiting");
         }
         assert_eq!(st.state, "waiting", "{st:?}");
-        let file = synth.join(format!("s{:02}_{}.c3d", st.sentence, st.emotion));
+        let mut emotion = st.emotion.clone();
+        if st.take == BAD_TAKE && matches!(bad, Some(None)) {
+            // Two emotions on: neither this sentence's previous take nor a copy of it.
+            let k = EMOTIONS.iter().position(|e| *e == emotion).expect("known");
+            emotion = EMOTIONS[(k + 2) % 4].to_string();
+            *bad = Some(Some(format!("s{:02}_{}.c3d", st.sentence, st.emotion)));
+        }
+        let file = synth.join(format!("s{:02}_{emotion}.c3d", st.sentence));
         let take = replay::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         assert!(matches!(
             send(control, SessionControl::Start).await,
             Reply::Confirm(_)
         ));
-        if st.take == GAPPY_TAKE && !gappy_done {
-            feed.perform(&take, None, take.n_markers() * 3 / 5, frame)
+        if st.take == GAPPY_TAKE && !*gappy_done {
+            feed.perform(&take, None, take.n_markers() * 3 / 5, *frame)
                 .await;
-            frame += take.n_frames() as i32 + 10;
+            *frame += take.n_frames() as i32 + 10;
             let refused = send(control, SessionControl::Stop).await;
             let Reply::Error { message, .. } = &refused else {
                 panic!("a take with 60 % of its markers missing was accepted: {refused:?}");
@@ -369,17 +487,17 @@ async fn performer(
                 send(control, SessionControl::Retake).await,
                 Reply::Confirm(_)
             ));
-            gappy_done = true;
+            *gappy_done = true;
         }
-        if st.take == KILLED_TAKE && !killed {
-            feed.perform(&take, Some(take.n_frames() / 2), 0, frame)
+        if st.take == KILLED_TAKE && !*killed {
+            feed.perform(&take, Some(take.n_frames() / 2), 0, *frame)
                 .await;
-            frame += take.n_frames() as i32 + 10;
+            *frame += take.n_frames() as i32 + 10;
             let t = Instant::now();
             // A second for the writer's sync, as a take killed at any moment would have.
             tokio::time::sleep(Duration::from_millis(1_200)).await;
             sigkill(child);
-            killed = true;
+            *killed = true;
             let listed = replay::session::Session::load(&dir.join("session.toml")).expect("kept");
             assert_eq!(
                 listed.takes.len(),
@@ -388,7 +506,7 @@ async fn performer(
             );
             *child = spawn_session(dir, synth, feed, cp, true).await;
             let again = status(control).await;
-            waited += t.elapsed();
+            *waited += t.elapsed();
             assert_eq!((again.take, again.state.as_str()), (KILLED_TAKE, "waiting"));
             assert_eq!((again.sentence, &again.emotion), (st.sentence, &st.emotion));
             let kept = replay::load(&dir.join(format!(
@@ -403,8 +521,8 @@ async fn performer(
             );
             continue;
         }
-        feed.perform(&take, None, 0, frame).await;
-        frame += take.n_frames() as i32 + 10;
+        feed.perform(&take, None, 0, *frame).await;
+        *frame += take.n_frames() as i32 + 10;
         let stopped = send(control, SessionControl::Stop).await;
         assert!(
             matches!(stopped, Reply::Confirm(_)),
@@ -412,8 +530,6 @@ async fn performer(
             st.take
         );
     }
-    assert!(gappy_done && killed);
-    waited
 }
 
 fn wait(child: &mut Child, limit: Duration) -> std::process::ExitStatus {

@@ -5,7 +5,10 @@
 //! Call order: [`Sitting::handle`] for each control; when it answers [`Step::Record`] the
 //! caller records, and on [`Step::Stop`] it stops, checks the take and reports the outcome
 //! with [`Sitting::handle_checked`]. [`Sitting::manifest`] is the `session.toml` of what was
-//! accepted, written after every accepted take.
+//! accepted, written after every accepted take. On [`Step::Finish`] the caller trains and
+//! analyses; when the analysis says what to redo it calls [`Sitting::offer`], and a
+//! `/session/redo` then prompts just those takes again ([`Step::Moved`]), while a second
+//! finish ends the session with the model as it is ([`Step::Close`]).
 
 pub mod advice;
 pub mod check;
@@ -58,6 +61,8 @@ pub enum Step {
     Status,
     /// Train and analyse what was accepted.
     Finish,
+    /// End the session with the model the last finish trained (its redo offer declined).
+    Close,
     /// The prompt moved (skip, back): show it.
     Moved,
 }
@@ -68,6 +73,10 @@ pub struct Sitting {
     script: Script,
     plan: Vec<Prompt>,
     accepted: Vec<bool>,
+    /// Accepted takes to record again: they stay in the manifest until their new take passes.
+    redo: Vec<bool>,
+    /// The takes the last finish said to redo, until `/session/redo` or another control.
+    offered: Vec<usize>,
     cursor: usize,
     state: State,
     last_accepted: Option<usize>,
@@ -81,6 +90,8 @@ impl Sitting {
         let plan = script.plan();
         Sitting {
             accepted: vec![false; plan.len()],
+            redo: vec![false; plan.len()],
+            offered: Vec::new(),
             script,
             plan,
             cursor: 0,
@@ -105,31 +116,60 @@ impl Sitting {
         s
     }
 
-    /// Offers the takes named (`s03_happy.c3d` or `s03_happy`) again: each stays on disk and
-    /// in the manifest's folder until its new take is accepted, and then moves to
+    /// Offers the takes named (`s03_happy.c3d` or `s03_happy`) again (`--redo`): each stays
+    /// on disk and in the manifest until its new take is accepted, and then moves to
     /// `replaced/`.
     ///
     /// # Errors
     /// A name that is no take of the script.
     pub fn redo(&mut self, names: &[String]) -> Result<(), String> {
-        for name in names {
-            let file = match name.ends_with(&format!(".{}", self.ext)) {
-                true => name.clone(),
-                false => format!("{name}.{}", self.ext),
-            };
-            let Some(i) = self
-                .plan
-                .iter()
-                .position(|p| p.file_name(&self.ext) == file)
-            else {
-                return Err(format!("--redo {name}: no such take in the script"));
-            };
-            self.accepted[i] = false;
+        let takes = self.takes_named(names)?;
+        self.redo_takes(&takes);
+        Ok(())
+    }
+
+    /// What the finish just made said to redo (take files or names): `/session/redo` records
+    /// them again, a second finish declines.
+    ///
+    /// # Errors
+    /// A name that is no take of the script.
+    pub fn offer(&mut self, names: &[String]) -> Result<(), String> {
+        self.offered = self.takes_named(names)?;
+        Ok(())
+    }
+
+    /// The take files offered for a redo (empty when none is).
+    pub fn offered(&self) -> Vec<String> {
+        self.offered
+            .iter()
+            .map(|&i| self.plan[i].file_name(&self.ext))
+            .collect()
+    }
+
+    fn takes_named(&self, names: &[String]) -> Result<Vec<usize>, String> {
+        let suffix = format!(".{}", self.ext);
+        names
+            .iter()
+            .map(|name| {
+                let file = match name.ends_with(&suffix) {
+                    true => name.clone(),
+                    false => format!("{name}{suffix}"),
+                };
+                self.plan
+                    .iter()
+                    .position(|p| p.file_name(&self.ext) == file)
+                    .ok_or_else(|| format!("redo {name}: no such take in the script"))
+            })
+            .collect()
+    }
+
+    fn redo_takes(&mut self, takes: &[usize]) {
+        for &i in takes {
+            self.redo[i] = true;
         }
-        self.cursor = 0;
+        self.cursor = takes.iter().copied().min().unwrap_or(0);
         self.state = State::Waiting;
         self.move_on();
-        Ok(())
     }
 
     /// The script.
@@ -162,6 +202,11 @@ impl Sitting {
         self.accepted.iter().filter(|&&a| a).count()
     }
 
+    /// Accepted takes waiting to be recorded again.
+    pub fn to_redo(&self) -> usize {
+        self.redo.iter().filter(|&&r| r).count()
+    }
+
     /// The take files' extension.
     pub fn ext(&self) -> &str {
         &self.ext
@@ -191,6 +236,10 @@ impl Sitting {
     pub fn handle(&mut self, control: SessionControl) -> Result<Step, String> {
         use SessionControl as C;
         let recording = self.state == State::Recording;
+        if !matches!(control, C::Status | C::Finish | C::Redo) && !recording {
+            // Doing anything else declines the offer: the next finish trains again.
+            self.offered.clear();
+        }
         match control {
             C::Status => Ok(Step::Status),
             C::Stop if recording => Ok(Step::Stop),
@@ -223,7 +272,16 @@ impl Sitting {
             C::Finish if self.accepted() == 0 => {
                 Err("no take accepted yet: record the session first".into())
             }
+            C::Finish if !self.offered.is_empty() => Ok(Step::Close),
             C::Finish => Ok(Step::Finish),
+            C::Redo if self.offered.is_empty() => {
+                Err("nothing offered to redo: finish first, it says what to redo".into())
+            }
+            C::Redo => {
+                let offered = std::mem::take(&mut self.offered);
+                self.redo_takes(&offered);
+                Ok(Step::Moved)
+            }
         }
     }
 
@@ -241,6 +299,7 @@ impl Sitting {
         match outcome {
             Ok(rate_hz) => {
                 self.accepted[self.cursor] = true;
+                self.redo[self.cursor] = false;
                 self.last_accepted = Some(self.cursor);
                 self.rate_hz.get_or_insert(rate_hz);
                 self.state = State::Waiting;
@@ -250,12 +309,13 @@ impl Sitting {
         }
     }
 
-    /// From the cursor on, the first take not accepted (wrapping round); done when none.
+    /// From the cursor on, the first take not accepted or to redo (wrapping round); done
+    /// when none.
     fn move_on(&mut self) {
         let n = self.plan.len();
         match (0..n)
             .map(|k| (self.cursor + k) % n)
-            .find(|&i| !self.accepted[i])
+            .find(|&i| !self.accepted[i] || self.redo[i])
         {
             Some(i) => self.cursor = i,
             None => self.state = State::Done,

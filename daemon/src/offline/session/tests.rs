@@ -76,14 +76,54 @@ fn redo_offers_named_takes_again_and_refuses_unknown_names() {
     assert_eq!(s.status().state, "done");
     s.redo(&["s02_sad".into(), "s01_happy.c3d".into()])
         .expect("known takes");
-    assert_eq!((s.accepted(), s.status().state.as_str()), (6, "waiting"));
+    // The old takes count until their new ones pass: a finish now still trains on 8.
+    assert_eq!((s.accepted(), s.to_redo()), (8, 2));
+    assert_eq!(s.status().state, "waiting");
+    assert_eq!(s.manifest().expect("takes").takes.len(), 8);
     assert_eq!(s.prompt().file_name("c3d"), "s01_happy.c3d");
     assert!(matches!(
         s.handle(C::Start),
-        Ok(Step::Record {
-            replaces: false,
-            ..
-        })
+        Ok(Step::Record { replaces: true, .. })
     ));
     assert!(s.redo(&["s09_sad".into()]).is_err());
+}
+
+#[test]
+fn a_finish_offers_its_redo_which_prompts_just_those_takes_or_a_second_finish_closes() {
+    let mut s = sitting();
+    assert!(
+        s.handle(C::Redo).is_err(),
+        "nothing offered before a finish"
+    );
+    for _ in 0..8 {
+        s.handle(C::Start).expect("start");
+        s.handle(C::Stop).expect("stop");
+        s.handle_checked(Ok(120.0));
+    }
+    assert_eq!(s.handle(C::Finish), Ok(Step::Finish));
+    s.offer(&["s02_sad.c3d".into(), "s02_neutral.c3d".into()])
+        .expect("known takes");
+    assert_eq!(s.offered(), ["s02_sad.c3d", "s02_neutral.c3d"]);
+    let mut declined = s.clone();
+    assert_eq!(declined.handle(C::Finish), Ok(Step::Close));
+    assert_eq!(s.handle(C::Redo), Ok(Step::Moved));
+    assert!(s.offered().is_empty());
+    let mut redone = Vec::new();
+    while s.status().state != "done" {
+        redone.push(s.prompt().file_name("c3d"));
+        s.handle(C::Start).expect("start");
+        s.handle(C::Stop).expect("stop");
+        s.handle_checked(Ok(120.0));
+    }
+    redone.sort();
+    assert_eq!(redone, ["s02_neutral.c3d", "s02_sad.c3d"]);
+    assert_eq!(s.accepted(), 8);
+    assert_eq!(s.handle(C::Finish), Ok(Step::Finish), "trains again");
+    s.offer(&["s01_sad".into()]).expect("a take");
+    s.handle(C::Back).expect("back");
+    assert_eq!(
+        s.handle(C::Finish),
+        Ok(Step::Finish),
+        "another control declined the offer"
+    );
 }

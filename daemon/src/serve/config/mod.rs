@@ -15,8 +15,9 @@ pub use super::config_error::ConfigError;
 
 mod exposure;
 mod values;
+pub(crate) use values::check_token;
 pub use values::parse_send;
-use values::{addr, check, check_token, performer, secret};
+use values::{addr, check, performer, secret};
 
 pub use engine::PerformerConfig;
 

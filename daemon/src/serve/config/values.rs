@@ -107,7 +107,7 @@ const TOKEN_BYTES: std::ops::RangeInclusive<usize> = 16..=256;
 ///
 /// # Errors
 /// [`ConfigError::Range`] naming `monitor_token`.
-pub(super) fn check_token(token: Option<String>) -> Result<Option<String>, ConfigError> {
+pub(crate) fn check_token(token: Option<String>) -> Result<Option<String>, ConfigError> {
     let Some(t) = token else { return Ok(None) };
     let safe = t
         .bytes()

@@ -4,7 +4,7 @@
 //! login prompt, whatever it asked for.
 
 use std::net::SocketAddr;
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use axum::extract::{ConnectInfo, State, WebSocketUpgrade};
@@ -14,7 +14,7 @@ use axum::routing::get;
 use axum::Router;
 use tokio::net::TcpListener;
 
-use super::access::Verdict;
+use super::access::{Access, Verdict};
 use super::{socket, Monitor};
 
 /// The page's files, embedded: (path, content type, text).
@@ -49,12 +49,12 @@ const FILES: &[(&str, &str, &str)] = &[
 ];
 const LOGIN: &str = include_str!("../../../web/login.html");
 
-const HTML: &str = "text/html; charset=utf-8";
-const CSS: &str = "text/css; charset=utf-8";
-const JS: &str = "text/javascript; charset=utf-8";
+pub(crate) const HTML: &str = "text/html; charset=utf-8";
+pub(crate) const CSS: &str = "text/css; charset=utf-8";
+pub(crate) const JS: &str = "text/javascript; charset=utf-8";
 const SVG: &str = "image/svg+xml";
 
-const PAGE_POLICY: &str = "default-src 'self'; script-src 'self'; style-src 'self'; \
+pub(crate) const PAGE_POLICY: &str = "default-src 'self'; script-src 'self'; style-src 'self'; \
     img-src 'self' data:; connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; \
     form-action 'self'";
 /// The login prompt carries its own style and nothing else.
@@ -77,22 +77,26 @@ pub(crate) async fn serve(listener: TcpListener, m: Arc<Monitor>) {
     }
 }
 
-fn header_str(headers: &HeaderMap, name: header::HeaderName) -> Option<&str> {
+pub(crate) fn header_str(headers: &HeaderMap, name: header::HeaderName) -> Option<&str> {
     headers.get(name).and_then(|v| v.to_str().ok())
 }
 
 /// `None` when the request may be served; otherwise the answer it gets. A wrong token is
-/// counted as refused, and with `strict` (the WebSocket, which no first visit opens) a missing
-/// one too.
-fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Option<Response> {
+/// counted in `refused`, and with `strict` (the WebSocket, a control, which no first visit
+/// sends) a missing one too.
+pub(crate) fn gate(
+    (access, refused): (&Access, &AtomicU64),
+    headers: &HeaderMap,
+    uri: &Uri,
+    strict: bool,
+) -> Option<Response> {
     let host = header_str(headers, header::HOST);
     let cookie = header_str(headers, header::COOKIE);
-    match m.access.check(host, uri.query(), cookie) {
+    match access.check(host, uri.query(), cookie) {
         Verdict::Allow => None,
         Verdict::SetCookie => {
             let mut r = (StatusCode::SEE_OTHER, [(header::LOCATION, uri.path())]).into_response();
-            if let Some(c) = m
-                .access
+            if let Some(c) = access
                 .set_cookie()
                 .and_then(|c| HeaderValue::from_str(&c).ok())
             {
@@ -102,7 +106,7 @@ fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Option<Res
         }
         Verdict::Login { wrong } => {
             if wrong || strict {
-                m.hub.refused.fetch_add(1, Ordering::Relaxed);
+                refused.fetch_add(1, Ordering::Relaxed);
                 tracing::debug!(target: "emoshift", wrong, "monitor page: no or a wrong token");
             }
             let note = if wrong {
@@ -119,7 +123,7 @@ fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Option<Res
             Some(secure(r.into_response(), LOGIN_POLICY))
         }
         Verdict::BadHost => {
-            m.hub.refused.fetch_add(1, Ordering::Relaxed);
+            refused.fetch_add(1, Ordering::Relaxed);
             let r = (
                 StatusCode::FORBIDDEN,
                 "this page answers to its own address only\n",
@@ -131,7 +135,7 @@ fn gate(m: &Monitor, headers: &HeaderMap, uri: &Uri, strict: bool) -> Option<Res
 
 /// One of the page's files.
 async fn file(State(m): State<Arc<Monitor>>, headers: HeaderMap, uri: Uri) -> Response {
-    if let Some(r) = gate(&m, &headers, &uri, false) {
+    if let Some(r) = gate((&m.access, &m.hub.refused), &headers, &uri, false) {
         return r;
     }
     match FILES.iter().find(|(path, _, _)| *path == uri.path()) {
@@ -151,7 +155,7 @@ async fn ws(
     uri: Uri,
     upgrade: WebSocketUpgrade,
 ) -> Response {
-    if let Some(r) = gate(&m, &headers, &uri, true) {
+    if let Some(r) = gate((&m.access, &m.hub.refused), &headers, &uri, true) {
         return r;
     }
     let host = header_str(&headers, header::HOST);
@@ -178,7 +182,7 @@ async fn ws(
 }
 
 /// Adds the headers every response carries.
-fn secure(mut r: Response, policy: &'static str) -> Response {
+pub(crate) fn secure(mut r: Response, policy: &'static str) -> Response {
     let h = r.headers_mut();
     h.insert(
         header::CONTENT_SECURITY_POLICY,

@@ -15,11 +15,12 @@
 //!   never disagree;
 //! - `access`: loopback by default; beyond loopback (or with `monitor_token` set) a token,
 //!   given once as `?token=` and then kept in a cookie; Host and Origin checked;
-//! - `http`: the routes, the embedded files and their security headers.
+//! - `http`: the routes, the embedded files and their security headers (its `gate` and
+//!   `secure` keep `emoshift session`'s performer page to the same rules).
 
-mod access;
+pub(crate) mod access;
 mod board;
-mod http;
+pub(crate) mod http;
 mod hub;
 mod socket;
 mod status;

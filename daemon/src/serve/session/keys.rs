@@ -16,6 +16,7 @@ fn control_of(line: &str) -> Option<SessionControl> {
         "s" | "skip" => SessionControl::Skip,
         "b" | "back" => SessionControl::Back,
         "f" | "finish" => SessionControl::Finish,
+        "r" | "redo" => SessionControl::Redo,
         "?" | "status" => SessionControl::Status,
         _ => return None,
     })
@@ -37,7 +38,7 @@ pub(super) fn spawn(tx: mpsc::Sender<Request>) {
                     }
                 }
                 None => eprintln!(
-                    "keys: Enter starts/stops, x stop, t retake, s skip, b back, f finish, ? status"
+                    "keys: Enter starts/stops, x stop, t retake, s skip, b back, f finish, r redo what finish offers, ? status"
                 ),
             }
             line.clear();

@@ -1,16 +1,21 @@
 //! `emoshift session`'s live half: the source runs for the whole session (the same as
 //! `record`'s, [`super::capture::listen`]); each take is a [`Take`] the frames go into while it
 //! records, checked the moment it stops ([`crate::offline::session::check`]); controls come
-//! from the keyboard and from an OSC control socket under serve's rules (its `Guard`: loopback
-//! by default, then the allow-list and the secret), and go through one [`Sitting`].
+//! from the keyboard, from an OSC control socket and from the performer page's buttons, the
+//! last two under serve's rules (its `Guard`: loopback by default, then the allow-list and the
+//! secret), and go through one [`Sitting`]. Finish trains and analyses (a [`Finisher`], off
+//! the runtime) while the source and the page run on; when it says what to redo, the session
+//! offers to record just those takes again now.
 
 pub mod files;
+mod finish;
 mod keys;
 mod osc;
+mod stopped;
 pub mod view;
 
 use std::net::SocketAddr;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use anyhow::{Context, Result};
@@ -25,7 +30,7 @@ use super::capture::take::Take;
 use super::capture::{self, Quiet, Source};
 use super::guard::Guard;
 use super::sources::Arrival;
-use crate::offline::session::check::{self, Expect};
+use crate::offline::session::advice::Advice;
 use crate::offline::session::{Sitting, State, Step};
 use view::View;
 
@@ -50,21 +55,45 @@ pub struct SessionConfig {
     pub keyboard: bool,
     /// Serve the performer's view here.
     pub monitor: Option<SocketAddr>,
+    /// The token the performer's view asks for (a random one when it is bound beyond this
+    /// host and none is given).
+    pub monitor_token: Option<String>,
 }
+
+/// Trains and analyses the accepted takes, saying what to redo; blocking (run off the
+/// runtime), and it tells the operator its progress itself.
+pub type Finisher = Arc<dyn Fn() -> Result<Advice> + Send + Sync>;
 
 /// How the session ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Ended {
-    /// The operator asked to finish: train and analyse.
+    /// Finished: the model is trained (and analysed), its redo offer taken or declined.
     Finish,
     /// Ctrl-C (the take being recorded is kept in `interrupted/`).
     Interrupted,
 }
 
-/// A control and where its answer goes (the encoded reply, or nothing for the keyboard).
+/// A control and where its answer goes (nothing for the keyboard).
 struct Request {
     control: SessionControl,
-    reply: Option<oneshot::Sender<Vec<u8>>>,
+    reply: Option<oneshot::Sender<Answer>>,
+}
+
+/// A control's answer: the OSC reply, and why the control was refused (for the page).
+struct Answer {
+    osc: Vec<u8>,
+    refused: Option<String>,
+}
+
+/// What the loop does after a control.
+#[derive(Debug, PartialEq)]
+enum After {
+    /// Take the next control.
+    Next,
+    /// Train and analyse.
+    Finish,
+    /// End the session (the model stands).
+    Close,
 }
 
 /// The take recording now, filled by the source's sink.
@@ -81,6 +110,7 @@ struct Live {
 pub async fn run(
     config: &SessionConfig,
     sitting: &mut Sitting,
+    finish: Finisher,
     shutdown: CancellationToken,
     say: &mut (dyn FnMut(&str) + Send),
 ) -> Result<Ended> {
@@ -92,19 +122,7 @@ pub async fn run(
     if config.keyboard {
         keys::spawn(tx.clone());
     }
-    let view = Arc::new(Mutex::new(View::default()));
-    lock(&view).update(sitting);
-    if let Some(addr) = config.monitor {
-        let listener = tokio::net::TcpListener::bind(addr).await.with_context(|| {
-            format!("binding the performer view {addr} (is another program on it?)")
-        })?;
-        say(&format!(
-            "performer view: http://{}/",
-            listener.local_addr()?
-        ));
-        tokio::spawn(view::serve(listener, view.clone(), stop.clone()));
-    }
-    let guard = Guard::with_rules(config.control_allow.clone(), config.control_secret.clone());
+    let (view, guard) = page(config, sitting, &tx, &stop, say).await?;
     let watch = config.monitor.is_some();
     let mut sink = |frame: &SourceFrame<'_>, arrival: &Arrival| {
         lock(&quiet).heard(arrival.received);
@@ -126,7 +144,15 @@ pub async fn run(
     let mut notice = |line: &str| tracing::warn!(target: "emoshift", "{line}");
     tell_prompt(sitting, say);
     let main = async {
-        let r = steps(config, sitting, (&live, &view), &mut rx, &stop, say).await;
+        let r = steps(
+            config,
+            (sitting, &finish),
+            (&live, &view),
+            &mut rx,
+            &stop,
+            say,
+        )
+        .await;
         stop.cancel();
         r
     };
@@ -137,6 +163,27 @@ pub async fn run(
     );
     listened?;
     ended
+}
+
+/// The view and the control rules, and the performer page when one is asked for.
+async fn page(
+    config: &SessionConfig,
+    sitting: &Sitting,
+    tx: &mpsc::Sender<Request>,
+    stop: &CancellationToken,
+    say: &mut (dyn FnMut(&str) + Send),
+) -> Result<(Arc<Mutex<View>>, Arc<Guard>)> {
+    let view = Arc::new(Mutex::new(View::default()));
+    lock(&view).update(sitting);
+    let guard = Arc::new(Guard::with_rules(
+        config.control_allow.clone(),
+        config.control_secret.clone(),
+    ));
+    if let Some(addr) = config.monitor {
+        let page = (view.clone(), guard.clone(), tx.clone());
+        view::spawn(addr, config.monitor_token.clone(), page, stop.clone(), say).await?;
+    }
+    Ok((view, guard))
 }
 
 /// The OSC control socket, when one is asked for.
@@ -151,7 +198,7 @@ async fn bind_control(addr: Option<SocketAddr>) -> Result<Option<Arc<UdpSocket>>
 /// The controls, one at a time, until finish or `stop`.
 async fn steps(
     config: &SessionConfig,
-    sitting: &mut Sitting,
+    (sitting, finish): (&mut Sitting, &Finisher),
     (live, view): (&Mutex<Live>, &Mutex<View>),
     rx: &mut mpsc::Receiver<Request>,
     stop: &CancellationToken,
@@ -165,7 +212,11 @@ async fn steps(
             }
             r = rx.recv() => match r {
                 Some(r) => r,
-                None => continue,
+                // No control left (no keyboard, socket or page): only Ctrl-C ends it.
+                None => {
+                    stop.cancelled().await;
+                    continue;
+                }
             },
         };
         let toggle = request.reply.is_none()
@@ -175,46 +226,67 @@ async fn steps(
             true => SessionControl::Stop,
             false => request.control,
         };
-        let control = Control::Session(asked);
-        let answer = match sitting.handle(asked) {
+        let after = match sitting.handle(asked) {
             Ok(step) => apply(config, sitting, live, step, say),
             Err(why) => Err(why),
         };
-        let mut out = Vec::with_capacity(256);
-        match &answer {
-            Ok(_) if asked == SessionControl::Status => {
-                protocol::encode_session_status_into(&sitting.status(), &mut out)
-            }
-            Ok(_) => protocol::encode_confirm_into(&control, &mut out),
-            Err(why) => {
-                if request.reply.is_none() {
-                    say(why);
-                }
-                protocol::encode_error_into(control.address(), why, &mut out)
-            }
-        };
+        if let (Err(why), None) = (&after, &request.reply) {
+            say(why);
+        }
+        let answer = answer(sitting, asked, after.as_ref().err());
         lock(view).update(sitting);
         if let Some(reply) = request.reply {
-            let _ = reply.send(out);
+            let _ = reply.send(answer);
         }
-        if answer == Ok(Some(Ended::Finish)) {
-            return Ok(Ended::Finish);
+        match after {
+            Ok(After::Close) => return Ok(Ended::Finish),
+            Ok(After::Finish) => {
+                let advice = finish::finishing(sitting, finish, rx, view).await?;
+                if finish::offer(sitting, &advice, view, say)? {
+                    return Ok(Ended::Finish);
+                }
+            }
+            _ => {}
         }
     }
 }
 
-/// Carries out a step; `Ok(Some(Finish))` ends the session. A take's I/O error is an `Err`
-/// for the operator (the session goes on).
+/// The answer to `asked`: the status, its confirmation, or why it was refused.
+fn answer(sitting: &Sitting, asked: SessionControl, refused: Option<&String>) -> Answer {
+    let control = Control::Session(asked);
+    let mut osc = Vec::with_capacity(256);
+    match refused {
+        None if asked == SessionControl::Status => {
+            protocol::encode_session_status_into(&sitting.status(), &mut osc)
+        }
+        None => protocol::encode_confirm_into(&control, &mut osc),
+        Some(why) => protocol::encode_error_into(control.address(), why, &mut osc),
+    };
+    Answer {
+        osc,
+        refused: refused.cloned(),
+    }
+}
+
+/// Carries out a step. A take's I/O error is an `Err` for the operator (the session goes
+/// on).
 fn apply(
     config: &SessionConfig,
     sitting: &mut Sitting,
     live: &Mutex<Live>,
     step: Step,
     say: &mut (dyn FnMut(&str) + Send),
-) -> Result<Option<Ended>, String> {
+) -> Result<After, String> {
     match step {
         Step::Status => {}
-        Step::Finish => return Ok(Some(Ended::Finish)),
+        Step::Finish => {
+            say("finishing: training and analysing the accepted takes ...");
+            return Ok(After::Finish);
+        }
+        Step::Close => {
+            say("the session ends with this model");
+            return Ok(After::Close);
+        }
         Step::Moved => tell_prompt(sitting, say),
         Step::Record { prompt, .. } => {
             let path = files::recording_path(&config.dir, &prompt, sitting.ext());
@@ -231,7 +303,8 @@ fn apply(
             ));
         }
         Step::Stop => {
-            let outcome = stop_and_check(config, sitting, live).map_err(|e| format!("{e:#}"));
+            let outcome =
+                stopped::stop_and_check(config, sitting, live).map_err(|e| format!("{e:#}"));
             let outcome = outcome.and_then(|checked| checked);
             match &outcome {
                 Ok(_) => say(&format!(
@@ -249,73 +322,7 @@ fn apply(
             }
         }
     }
-    Ok(None)
-}
-
-/// Closes the take, checks it, and puts it in place (accepted: its name, the manifest
-/// written) or aside (`refused/`). The inner result is the check's: the rate, or why refused.
-fn stop_and_check(
-    config: &SessionConfig,
-    sitting: &Sitting,
-    live: &Mutex<Live>,
-) -> Result<Result<f64, String>> {
-    let (take, error) = {
-        let mut l = lock(live);
-        (l.take.take(), l.error.take())
-    };
-    let Some(take) = take else {
-        return Ok(Err("nothing was recording".into()));
-    };
-    let relabelled = take.relabelled();
-    let captured = take.finish()?;
-    if let Some(e) = error {
-        return Err(e);
-    }
-    let prompt = sitting.prompt().clone();
-    let recording = files::recording_path(&config.dir, &prompt, sitting.ext());
-    let Some(captured) = captured else {
-        return Ok(Err(check::Refusal::Empty.to_string()));
-    };
-    let take = replay::load(&recording)
-        .with_context(|| format!("cannot read back {}", recording.display()))?;
-    let previous = match sitting.previous_accepted() {
-        Some(p) => Some(replay::load(&config.dir.join(p.file_name(sitting.ext())))?),
-        None => None,
-    };
-    let expect = Expect {
-        seconds: sitting.script().sentences[prompt.sentence].seconds_range(),
-        markers: previous.as_ref().map(|p| p.labels.as_slice()),
-        min_seen: config.min_seen,
-    };
-    if let Err(refusal) = check::check(&take, relabelled, &expect, previous.as_ref()) {
-        files::move_aside(&recording, &config.dir, "refused")?;
-        return Ok(Err(refusal.to_string()));
-    }
-    accept(
-        config,
-        sitting,
-        &recording,
-        &prompt.file_name(sitting.ext()),
-    )?;
-    Ok(Ok(captured.rate_hz))
-}
-
-/// Puts an accepted take under its name (an accepted take it replaces goes to `replaced/`)
-/// and writes the manifest with it.
-fn accept(config: &SessionConfig, sitting: &Sitting, recording: &Path, name: &str) -> Result<()> {
-    let final_path = config.dir.join(name);
-    if final_path.exists() {
-        files::move_aside(&final_path, &config.dir, "replaced")?;
-    }
-    std::fs::rename(recording, &final_path)
-        .with_context(|| format!("cannot name the take {}", final_path.display()))?;
-    let mut after = sitting.clone();
-    after.handle_checked(Ok(0.0));
-    if let Some(mut manifest) = after.manifest() {
-        manifest.rate_hz = sitting.manifest().map_or(manifest.rate_hz, |m| m.rate_hz);
-        files::write_manifest(&config.dir, &manifest)?;
-    }
-    Ok(())
+    Ok(After::Next)
 }
 
 /// Ctrl-C: a take being recorded is closed and kept in `interrupted/`.

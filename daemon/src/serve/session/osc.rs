@@ -1,6 +1,9 @@
-//! The session's OSC control socket: `/session/*` controls admitted under serve's rules go to
-//! the session and are answered with its reply; anything else is refused.
+//! The session's controls from the network: the OSC control socket and the performer page
+//! both hand the OSC message they got to [`admit`], which holds it to serve's rules (its
+//! `Guard`: the allow-list by the sender's address, the secret as the last argument), passes
+//! `/session/*` controls to the session and refuses anything else.
 
+use std::net::SocketAddr;
 use std::sync::Arc;
 
 use protocol::Control;
@@ -8,11 +11,47 @@ use tokio::net::UdpSocket;
 use tokio::sync::{mpsc, oneshot};
 use tokio_util::sync::CancellationToken;
 
-use super::Request;
+use super::{Answer, Request};
 use crate::serve::guard::Guard;
 
-/// The OSC control socket: admitted session controls to the session, answered with its reply;
-/// anything else refused the way serve refuses it.
+/// One control message from `peer`, admitted or refused, and the session's answer; `None`
+/// when the session is gone.
+pub(super) async fn admit(
+    guard: &Guard,
+    tx: &mpsc::Sender<Request>,
+    peer: SocketAddr,
+    bytes: &[u8],
+) -> Option<Answer> {
+    let refused = |address: &str, why: String| {
+        let mut osc = Vec::with_capacity(256);
+        protocol::encode_error_into(address, &why, &mut osc);
+        Answer {
+            osc,
+            refused: Some(why),
+        }
+    };
+    match guard.admit(peer).and_then(|()| guard.decode(bytes)) {
+        Ok(Control::Session(control)) => {
+            let (reply, answer) = oneshot::channel();
+            let request = Request {
+                control,
+                reply: Some(reply),
+            };
+            tx.send(request).await.ok()?;
+            answer.await.ok()
+        }
+        Ok(other) => Some(refused(
+            other.address(),
+            "a calibration session takes /session/* controls only".into(),
+        )),
+        Err(refusal) => {
+            guard.warn_refused(peer, "", &refusal);
+            Some(refused("", refusal.to_string()))
+        }
+    }
+}
+
+/// The OSC control socket: each datagram through [`admit`], answered to its sender.
 pub(super) async fn control_task(
     socket: Option<Arc<UdpSocket>>,
     guard: &Guard,
@@ -29,32 +68,9 @@ pub(super) async fn control_task(
                 Err(_) => continue,
             },
         };
-        let admitted = guard.admit(peer).and_then(|()| guard.decode(&buf[..len]));
-        let mut out = Vec::with_capacity(256);
-        match admitted {
-            Ok(Control::Session(control)) => {
-                let (reply, answer) = oneshot::channel();
-                let request = Request {
-                    control,
-                    reply: Some(reply),
-                };
-                if tx.send(request).await.is_err() {
-                    return;
-                }
-                match answer.await {
-                    Ok(bytes) => out = bytes,
-                    Err(_) => return,
-                }
-            }
-            Ok(other) => {
-                let why = "a calibration session takes /session/* controls only";
-                protocol::encode_error_into(other.address(), why, &mut out);
-            }
-            Err(refusal) => {
-                guard.warn_refused(peer, "", &refusal);
-                protocol::encode_error_into("", &refusal.to_string(), &mut out);
-            }
-        }
-        let _ = socket.send_to(&out, peer).await;
+        let Some(answer) = admit(guard, &tx, peer, &buf[..len]).await else {
+            return;
+        };
+        let _ = socket.send_to(&answer.osc, peer).await;
     }
 }
