@@ -17,10 +17,17 @@ Per minute: the daemon's RSS, open descriptors and threads; frames sent, receive
 steady subscriber and lost (gaps in a stream's frame numbers, or frames never seen); the
 latency from the send to a subscriber's receipt (the capture time travels in the frame), p50 and
 p99 over that minute; the sender's worst lateness (this process stalled: the stream resumes at
-its rate rather than bursting). It fails when, from the end of minute 1 to the end, RSS grows more than
-10 %, descriptors or threads grow, any frame is lost, or the last minute's p99 is more than
-4 times minute 1's and 10 ms above it (latency building up; this receiver's own jitter is a few
-ms).
+its rate rather than bursting). It fails when RSS keeps growing (more than 10 % from the run's
+middle minute to its last, or more than 25 % from minute 1), descriptors or threads grow, any
+frame is lost, or the last minute's p99 is more than 4 times minute 1's and 10 ms above it
+(latency building up; this receiver's own jitter is a few ms).
+
+Why RSS is judged over the second half: the daemon's live heap stays flat (heaptrack over 7
+minutes with a rotation and a reload each minute: 2.5-2.9 MB in use throughout), but its RSS
+steps up over the first rotations and reloads, as the allocator's per-thread arenas and the
+binary's code pages (about 7 of its 11 MB of text) are touched for the first time, and then
+holds. A leak grows all run long; that warm-up does not. `anon_MB` (RssAnon: heap, arenas,
+stacks) is printed beside RSS to tell the two apart.
 """
 
 import argparse
@@ -204,14 +211,16 @@ def free_port():
 
 
 def proc_counts(pid):
-    rss_kb = threads = 0
+    rss_kb = anon_kb = threads = 0
     with open("/proc/%d/status" % pid) as f:
         for line in f:
             if line.startswith("VmRSS:"):
                 rss_kb = int(line.split()[1])
+            elif line.startswith("RssAnon:"):
+                anon_kb = int(line.split()[1])
             elif line.startswith("Threads:"):
                 threads = int(line.split()[1])
-    return rss_kb / 1024.0, len(os.listdir("/proc/%d/fd" % pid)), threads
+    return rss_kb / 1024.0, anon_kb / 1024.0, len(os.listdir("/proc/%d/fd" % pid)), threads
 
 
 class Control:
@@ -419,12 +428,12 @@ def soak(args, exe, work):
                 control.drain()
                 for s in steady:
                     s.drain(True)
-                rss, fds, threads = proc_counts(daemon.pid)
+                rss, anon, fds, threads = proc_counts(daemon.pid)
                 lat = sorted(x for s in steady for x in s.latencies)
                 sent = sum(p.sent for p in performers)
                 lost = sum(s.lost for s in steady)
                 row = {
-                    "minute": minute, "rss_mb": rss, "fds": fds, "threads": threads,
+                    "minute": minute, "rss_mb": rss, "anon_mb": anon, "fds": fds, "threads": threads,
                     "sent": sent - sent_at_minute,
                     "received": min(s.received for s in steady),
                     "lost": lost - lost_at_minute,
@@ -479,10 +488,10 @@ def soak(args, exe, work):
 
 def print_row(row, header):
     if header:
-        print("minute  rss_MB  fds  threads  frames_sent  received  lost  p50_ms  p99_ms  "
+        print("minute  rss_MB  anon_MB  fds  threads  frames_sent  received  lost  p50_ms  p99_ms  "
               "model_swaps  bad_packets  dropped  sender_late_ms")
-    print("%6d  %6.1f  %3d  %7d  %11d  %8d  %4d  %6.2f  %6.2f  %11d  %11d  %7d  %14.1f" % (
-        row["minute"], row["rss_mb"], row["fds"], row["threads"], row["sent"],
+    print("%6d  %6.1f  %7.1f  %3d  %7d  %11d  %8d  %4d  %6.2f  %6.2f  %11d  %11d  %7d  %14.1f" % (
+        row["minute"], row["rss_mb"], row["anon_mb"], row["fds"], row["threads"], row["sent"],
         row["received"], row["lost"], row["p50_ms"], row["p99_ms"], row["swaps"], row["bad"],
         row["dropped"], row["late_ms"]), flush=True)
 
@@ -491,8 +500,12 @@ def judge(rows, control, failures, work):
     if len(rows) < 2:
         failures.append("fewer than 2 minutes: nothing to compare; run --minutes 2 or more")
     else:
-        first, last = rows[0], rows[-1]
-        if last["rss_mb"] > 1.10 * first["rss_mb"]:
+        first, middle, last = rows[0], rows[(len(rows) - 1) // 2], rows[-1]
+        # Warm-up (arenas, code pages) steps RSS up early and then holds; a leak keeps growing.
+        if last["rss_mb"] > 1.10 * middle["rss_mb"]:
+            failures.append("RSS still growing in the second half: minute %d %.1f -> %.1f MB"
+                            % (middle["minute"], middle["rss_mb"], last["rss_mb"]))
+        if last["rss_mb"] > 1.25 * first["rss_mb"]:
             failures.append("RSS grew %.1f -> %.1f MB" % (first["rss_mb"], last["rss_mb"]))
         if last["fds"] > first["fds"]:
             failures.append("descriptors grew %d -> %d" % (first["fds"], last["fds"]))
