@@ -37,6 +37,7 @@
 //! `main.rs` parses [`cli::Cli`] and calls [`commands::main_with`], which installs
 //! [`logging`], runs the command and maps its error to an exit code ([`exit::code_for`]).
 #![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub mod cli;
 pub mod commands;

@@ -21,6 +21,7 @@
 //! Main types: [`IcaModel`], [`FastIcaParams`], [`TrainReport`], [`Projector`],
 //! [`FrameEdit`], [`EmotionLevels`].
 #![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub mod dtw;
 pub mod edit;

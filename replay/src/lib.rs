@@ -8,6 +8,7 @@
 //!
 //! This crate must not know about ICA models (the daemon joins takes and models).
 #![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub mod blocks;
 pub mod c3d;
