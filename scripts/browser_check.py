@@ -212,7 +212,7 @@ def ws_handshake(origin, cookie):
     headers = {"Upgrade": "websocket", "Connection": "Upgrade", "Sec-WebSocket-Version": "13",
                "Sec-WebSocket-Key": "dGhlIHNhbXBsZSBub25jZQ==", "Origin": origin}
     if cookie:
-        headers["Cookie"] = f"emoshift_monitor={TOKEN}"
+        headers["Cookie"] = f"emoshift_monitor_{PAGE.port}={TOKEN}"
     conn.request("GET", "/ws", headers=headers)
     code = conn.getresponse().status
     conn.close()
@@ -411,7 +411,7 @@ def post_control(origin, cookie, url):
     conn = http.client.HTTPConnection(page.hostname, page.port, timeout=5)
     headers = {"Origin": origin, "Content-Type": "application/octet-stream"}
     if cookie:
-        headers["Cookie"] = f"emoshift_monitor={token}"
+        headers["Cookie"] = f"emoshift_monitor_{page.port}={token}"
     conn.request("POST", "/control", body=osc("/session/start", SECRET), headers=headers)
     code = conn.getresponse().status
     conn.close()

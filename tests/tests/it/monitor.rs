@@ -253,7 +253,7 @@ async fn beyond_loopback_a_token_then_a_cookie_and_foreign_origins_never() {
     assert!(wrong.contains("not this daemon"), "{wrong}");
     let right = get(at, &format!("/?token={token}"), &host, None).await;
     assert!(right.starts_with("HTTP/1.1 303"), "{right}");
-    let cookie = format!("emoshift_monitor={token}");
+    let cookie = format!("emoshift_monitor_{}={token}", at.port());
     assert!(
         right.contains(&cookie) && right.contains("HttpOnly"),
         "{right}"

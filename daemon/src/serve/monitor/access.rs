@@ -13,13 +13,18 @@
 
 use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr};
 
-/// The cookie that carries the token after the first visit.
+/// The cookie that carries the token after the first visit, suffixed with the page's port.
+///
+/// Browsers keep cookies per host, not per port: serve's monitor and a session's performer
+/// page on one stage PC would otherwise log each other out.
 pub(crate) const COOKIE: &str = "emoshift_monitor";
 
 /// The access rules of one monitor.
 #[derive(Debug, Clone)]
 pub(crate) struct Access {
     token: Option<String>,
+    /// [`COOKIE`]`_<port>`.
+    cookie: String,
 }
 
 /// What to do with a request.
@@ -49,7 +54,8 @@ impl Access {
             (None, true) => None,
             (None, false) => Some(random_token()),
         };
-        Access { token }
+        let cookie = format!("{COOKIE}_{}", bound.port());
+        Access { token, cookie }
     }
 
     /// The token pages need, if any.
@@ -75,7 +81,7 @@ impl Access {
             return Verdict::SetCookie;
         }
         if cookie
-            .and_then(|c| cookie_value(c, COOKIE))
+            .and_then(|c| cookie_value(c, &self.cookie))
             .is_some_and(|c| same(c, token))
         {
             return Verdict::Allow;
@@ -98,7 +104,7 @@ impl Access {
     pub(crate) fn set_cookie(&self) -> Option<String> {
         self.token
             .as_ref()
-            .map(|t| format!("{COOKIE}={t}; Path=/; HttpOnly; SameSite=Strict"))
+            .map(|t| format!("{}={t}; Path=/; HttpOnly; SameSite=Strict", self.cookie))
     }
 }
 

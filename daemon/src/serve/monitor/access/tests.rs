@@ -47,7 +47,13 @@ fn beyond_this_host_a_random_token_then_a_cookie() {
         a.check(host, None, Some(&format!("theme=dark; {sent}"))),
         Verdict::Allow
     );
-    let forged = format!("{COOKIE}={}", &token[..31]);
+    let other_page = format!("{COOKIE}_9081={token}");
+    assert_eq!(
+        a.check(host, None, Some(&other_page)),
+        Verdict::Login { wrong: false },
+        "another port's page keeps its own cookie"
+    );
+    let forged = format!("{COOKIE}_9080={}", &token[..31]);
     assert_eq!(
         a.check(host, None, Some(&forged)),
         Verdict::Login { wrong: false }
