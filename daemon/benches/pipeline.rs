@@ -11,7 +11,8 @@
 //! (issue 36): the processing thread's share of a crash-safe recording (each frame encoded and
 //! handed to the file's own thread; the writes, syncs and header counts happen there). Its
 //! files go to /dev/shm where there is one, each sample's deleted after it, so the bench
-//! measures the frame path rather than the disk.
+//! measures the frame path rather than the disk. And without a model (issue 37: `serve`
+//! started before the performer's model exists): the same frames passed through unedited.
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
@@ -65,6 +66,8 @@ enum Beside {
     Nothing,
     MonitorPage,
     Recording,
+    /// No model: the pipeline passes the frames through.
+    NoModel,
 }
 
 /// Where a recording bench writes: memory where the system has a tmpfs.
@@ -82,7 +85,10 @@ fn scratch() -> tempfile::TempDir {
 fn bench_model(c: &mut Criterion, name: &str, model: IcaModel, beside: Beside) {
     let monitor = beside == Beside::MonitorPage;
     let model = Arc::new(model);
-    let mut pipeline = Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default());
+    let mut pipeline = match beside {
+        Beside::NoModel => Pipeline::without_model(vec![], PipelineConfig::default()),
+        _ => Pipeline::new(Arc::clone(&model), vec![], PipelineConfig::default()),
+    };
     let mut demux = OscDemux::new(109, Arc::new(InputCounters::named("osc")));
     let peer: SocketAddr = "127.0.0.1:9".parse().expect("literal address");
     let board = Arc::new(Board::new());
@@ -165,6 +171,12 @@ fn whole_frame_path(c: &mut Criterion) {
         "pipeline 109 markers m=20 compact",
         random_model(109, 20, 1),
         Beside::Nothing,
+    );
+    bench_model(
+        c,
+        "pipeline 109 markers compact, no model (passthrough)",
+        random_model(109, 20, 1),
+        Beside::NoModel,
     );
     bench_model(
         c,

@@ -92,9 +92,10 @@ impl Processed<'_> {
         self.output.header().frame_number
     }
 
-    /// The stream's model labels (the order of [`Processed::output`]).
+    /// The stream's model labels, the order of [`Processed::output`] (the source's labels when
+    /// the stream has no model and passes its frames through).
     pub fn labels(&self) -> &[String] {
-        self.stream.model.labels()
+        self.stream.labels()
     }
 
     /// The source's labels of [`Processed::input`].
@@ -102,9 +103,9 @@ impl Processed<'_> {
         self.stream.source_labels()
     }
 
-    /// The stream's model rate.
+    /// The stream's model rate (the pipeline's passthrough rate without a model).
     pub fn rate_hz(&self) -> f64 {
-        self.stream.model.rate_hz()
+        self.stream.rate_hz()
     }
 
     /// The edited positions in model order (gaps filled by the model).

@@ -220,7 +220,7 @@ impl Streams {
                 id: s.identity.id,
                 name: s.identity.name.clone(),
                 performer: s.performer.map(|i| performers[i].name.clone()),
-                model_markers: s.model.markers(),
+                model_markers: s.labels().len(),
                 unmatched_markers: s.unmatched_markers(),
                 target: s.edit.target().to_string(),
                 amount: s.edit.amount(),

@@ -13,9 +13,14 @@ pub struct ServeArgs {
     /// TOML config file (every flag has a key; see docs/emoshift.toml).
     #[arg(long, env = "EMOSHIFT_CONFIG")]
     pub config: Option<PathBuf>,
-    /// Model file (JSON).
+    /// Model file (JSON). Without one (a new performer's model does not exist yet), frames
+    /// pass through unedited and can be recorded; /model/load loads one later.
     #[arg(long, env = "EMOSHIFT_MODEL")]
     pub model: Option<PathBuf>,
+    /// Without a model: the rate announced and recorded for the streams passed through, Hz
+    /// [default: 120].
+    #[arg(long, value_name = "HZ")]
+    pub passthrough_rate: Option<f64>,
     /// Frame socket, IP:PORT [default: 127.0.0.1:9000].
     #[arg(long, value_name = "IP:PORT")]
     pub listen: Option<String>,

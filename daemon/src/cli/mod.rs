@@ -6,6 +6,7 @@ use clap::{Args, Parser, Subcommand};
 
 mod live;
 mod offline;
+mod range;
 mod values;
 
 pub use live::{
@@ -15,6 +16,7 @@ pub use offline::{
     AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InjectArgs, InspectArgs, KeyValue, ProjectArgs,
     SynthArgs, TrainArgs,
 };
+pub use range::RangeArgs;
 
 /// A command-line error on one line, as every other failure is: clap's message with its
 /// indented details joined on, then where to look.

@@ -137,13 +137,9 @@ pub struct ConvertArgs {
     pub input: PathBuf,
     /// Output take; its extension picks the format.
     pub output: PathBuf,
-    /// First frame kept: a frame number as the file numbers it (240) or seconds from the
-    /// take's start (2.5s) [default: the first].
-    #[arg(long, value_name = "FRAME|SECONDSs")]
-    pub start: Option<crate::offline::trim::FrameOrTime>,
-    /// Last frame kept, inclusive, likewise [default: the last].
-    #[arg(long, value_name = "FRAME|SECONDSs")]
-    pub end: Option<crate::offline::trim::FrameOrTime>,
+    /// The frames kept.
+    #[command(flatten)]
+    pub range: super::RangeArgs,
     /// Overwrite the output if it exists.
     #[arg(long)]
     pub force: bool,
@@ -305,6 +301,10 @@ pub struct EditArgs {
     /// Keep the take's gaps in the output instead of filling them from the model.
     #[arg(long)]
     pub keep_gaps: bool,
+    /// The frames written (the frames before are edited, not written, so the range is the
+    /// whole edit's; the output numbers its frames as the input does).
+    #[command(flatten)]
+    pub range: super::RangeArgs,
     /// Overwrite the output if it exists.
     #[arg(long)]
     pub force: bool,

@@ -9,8 +9,9 @@ pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
     crate::offline::output::check_out(&args.output, &[&args.input], args.force)?;
     let cut_off = crate::offline::takes::cut_off(&args.input);
     let mut take = crate::offline::load_take(&args.input)?;
-    if args.start.is_some() || args.end.is_some() {
-        let range = crate::offline::trim::frame_range(&take, args.start, args.end)
+    if args.range.is_some() {
+        let (start, end) = (args.range.start, args.range.end);
+        let range = crate::offline::trim::frame_range(&take, start, end)
             .with_context(|| format!("{}", args.input.display()))?;
         take.keep_frames(range);
     }

@@ -26,6 +26,8 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
         replace_from: args.replace_emotion_from.clone(),
         add_from,
         keep_gaps: args.keep_gaps,
+        start: args.range.start,
+        end: args.range.end,
     };
     let mut inputs = vec![args.file.as_path(), args.model.as_path()];
     inputs.extend(args.replace_emotion_from.as_deref());
@@ -37,7 +39,12 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
         let take = offline::load_take(&args.file)?;
         let map = offline::match_take(&model, &take, &args.file)?;
         let notices = offline::take_notices(&model, (&take.labels, take.rate_hz), &map);
-        let out = edit_take(&model, &args.model, &take, &args.file, &request).map_err(usage)?;
+        let mut out = edit_take(&model, &args.model, &take, &args.file, &request).map_err(usage)?;
+        if args.range.is_some() {
+            let range = offline::trim::frame_range(&out, request.start, request.end)
+                .with_context(|| format!("{}", args.file.display()))?;
+            out.keep_frames(range);
+        }
         replay::save(&args.out, &out).with_context(|| format!("{}", args.out.display()))?;
         (out.n_frames(), notices)
     } else {

@@ -26,6 +26,9 @@ pub(crate) fn config(args: &ServeArgs) -> Result<Config> {
     if let Some(m) = &args.model {
         raw.model = Some(m.clone());
     }
+    if let Some(r) = args.passthrough_rate {
+        raw.passthrough_rate_hz = Some(r);
+    }
     if let Some(l) = &args.listen {
         raw.listen = Some(l.clone());
     }
@@ -97,6 +100,15 @@ pub(crate) fn run(args: &ServeArgs) -> Result<()> {
     let config = config(args)?;
     for warning in config.exposure_warnings() {
         tracing::warn!(target: "emoshift", "{warning}");
+    }
+    if config.model.is_none() && config.performers.iter().all(|p| p.model.is_none()) {
+        tracing::warn!(
+            target: "emoshift",
+            rate_hz = config.passthrough_rate_hz,
+            "no model: frames pass through unedited (recording works); load one with /model/load \
+             PATH, or `emoshift session ... --load-into {}`",
+            config.control
+        );
     }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)

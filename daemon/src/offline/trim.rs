@@ -40,12 +40,98 @@ impl FromStr for FrameOrTime {
 }
 
 impl FrameOrTime {
-    /// The 0-based frame index of `take` this names (past the end: the frame count).
-    fn index(self, take: &Take) -> i64 {
+    /// The 0-based frame index this names in a take whose first frame is `first_frame`, at
+    /// `rate_hz` (may be negative, or past the end).
+    fn index(self, (first_frame, rate_hz): (i64, f64)) -> i64 {
         match self {
-            FrameOrTime::Frame(n) => n - take.first_frame,
-            FrameOrTime::Seconds(s) => (s * take.rate_hz).round() as i64,
+            FrameOrTime::Frame(n) => n - first_frame,
+            FrameOrTime::Seconds(s) => (s * rate_hz).round() as i64,
         }
+    }
+}
+
+/// A range as frame indices from a take's first frame, `from..to`, before the take's length is
+/// known (a streamed take): `to` is `None` without `--end`. [`Cut::check`] refuses what keeps
+/// nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Cut {
+    /// The first frame kept.
+    pub from: usize,
+    /// The frame after the last kept (`None`: to the end).
+    pub to: Option<usize>,
+}
+
+impl Cut {
+    /// The cut `start`..=`end` of a take whose first frame is `first_frame`, at `rate_hz`.
+    pub fn new(
+        (first_frame, rate_hz): (i64, f64),
+        start: Option<FrameOrTime>,
+        end: Option<FrameOrTime>,
+    ) -> Cut {
+        let at = (first_frame, rate_hz);
+        let from = start.map_or(0, |s| s.index(at)).max(0) as usize;
+        let to = end.map(|e| (e.index(at) + 1).max(0) as usize);
+        Cut { from, to }
+    }
+
+    /// Whether frame index `f` is kept.
+    pub fn keeps(&self, f: usize) -> bool {
+        f >= self.from && self.to.is_none_or(|to| f < to)
+    }
+
+    /// Whether no frame at index `f` or later is kept (a streamed take may stop reading).
+    pub fn is_past(&self, f: usize) -> bool {
+        self.to.is_some_and(|to| f >= to)
+    }
+
+    /// The frames kept of a take of `frames` frames (`None`: not known yet).
+    ///
+    /// # Errors
+    /// A cut that keeps no frame (of the take, when its length is known), naming the take's own
+    /// range and what to write.
+    pub fn check(&self, take: Span, frames: Option<usize>) -> Result<Option<Range<usize>>> {
+        let to = match (self.to, frames) {
+            (Some(to), Some(n)) => Some(to.min(n)),
+            (to, n) => to.or(n),
+        };
+        let from = match frames {
+            Some(n) => self.from.min(n),
+            None => self.from,
+        };
+        if to.is_some_and(|to| from >= to) {
+            bail!("{}", take.nothing_kept(frames));
+        }
+        Ok(frames.map(|_| from..to.unwrap_or(from)))
+    }
+}
+
+/// What a take's frames are numbered and timed by: its first frame number and rate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Span {
+    /// The first frame's number.
+    pub first_frame: i64,
+    /// Frames per second.
+    pub rate_hz: f64,
+}
+
+impl Span {
+    /// `--start/--end keep no frame: the take has frames 1 to 500 (4.990 s at 100 Hz); give a
+    /// start before its end, within those` (without `frames`, its first frame only).
+    pub fn nothing_kept(&self, frames: Option<usize>) -> String {
+        let first = self.first_frame;
+        let what = match frames {
+            Some(n) => format!(
+                "the take has frames {first} to {} ({:.3} s at {} Hz)",
+                first + n as i64 - 1,
+                n.saturating_sub(1) as f64 / self.rate_hz,
+                self.rate_hz
+            ),
+            None => format!("the take starts at frame {first} ({} Hz)", self.rate_hz),
+        };
+        format!(
+            "--start/--end keep no frame: {what}; give a frame number or a time (2.5s) from \
+             there, the start before the end"
+        )
     }
 }
 
@@ -58,19 +144,13 @@ pub fn frame_range(
     start: Option<FrameOrTime>,
     end: Option<FrameOrTime>,
 ) -> Result<Range<usize>> {
-    let n = take.n_frames() as i64;
-    let from = start.map_or(0, |s| s.index(take)).clamp(0, n);
-    let to = end.map_or(n, |e| e.index(take) + 1).clamp(0, n);
-    if from >= to {
-        bail!(
-            "--start/--end keep no frame: the take has frames {} to {} ({:.3} s at {} Hz)",
-            take.first_frame,
-            take.first_frame + n - 1,
-            take.time_of(take.n_frames().saturating_sub(1)),
-            take.rate_hz
-        );
-    }
-    Ok(from as usize..to as usize)
+    let span = Span {
+        first_frame: take.first_frame,
+        rate_hz: take.rate_hz,
+    };
+    let cut = Cut::new((take.first_frame, take.rate_hz), start, end);
+    let range = cut.check(span, Some(take.n_frames()))?;
+    Ok(range.expect("the take's length is known"))
 }
 
 #[cfg(test)]

@@ -49,9 +49,6 @@ pub enum ConfigError {
         /// Accepted range.
         range: &'static str,
     },
-    /// No model given.
-    #[error("no model: pass --model model.json or set model in the config")]
-    NoModel,
     /// The frame and control sockets on one UDP port.
     #[error(
         "listen {listen} and control {control} share a port: the frame socket and the control \

@@ -35,9 +35,10 @@ pub(crate) struct ControlCtx {
     pub(crate) socket: Arc<UdpSocket>,
     pub(crate) cmd_tx: Sender<Request>,
     pub(crate) stats: Arc<Mutex<Stats>>,
-    pub(crate) model_path: Arc<Mutex<PathBuf>>,
-    /// The default model now (for `/emotion/list`).
-    pub(crate) model: Arc<Mutex<Arc<IcaModel>>>,
+    /// The default model's file (SIGHUP reloads it); `None` before one is loaded.
+    pub(crate) model_path: Arc<Mutex<Option<PathBuf>>>,
+    /// The default model now (for `/emotion/list`); `None`: frames pass through unedited.
+    pub(crate) model: Arc<Mutex<Option<Arc<IcaModel>>>>,
     pub(crate) tracker: TaskTracker,
     /// Who may control, and how.
     pub(crate) guard: Arc<Guard>,
@@ -152,8 +153,11 @@ pub(crate) async fn execute(
             let pairs = ctx.stats.lock().map(|s| s.pairs()).unwrap_or_default();
             return Answer::Status(pairs);
         }
-        Control::EmotionList => match ctx.model.lock().map(|m| emotion_list(&m)) {
-            Ok(list) => return Answer::EmotionList(list),
+        Control::EmotionList => match ctx.model.lock().map(|m| m.as_deref().map(emotion_list)) {
+            Ok(Some(list)) => return Answer::EmotionList(list),
+            Ok(None) => Err(Refusal::Edit(
+                engine::edit_state::EditRefused::NoModel.to_string(),
+            )),
             Err(_) => Err(Refusal::Model("model unavailable".into())),
         },
         Control::ModelLoad(path) => reload(ctx, PathBuf::from(path)).await,
@@ -218,13 +222,13 @@ async fn reload(ctx: &ControlCtx, path: PathBuf) -> Reply {
     let model = Arc::new(model);
     ask(ctx, Command::SetModel(Arc::clone(&model))).await?;
     if let Ok(mut p) = ctx.model_path.lock() {
-        *p = path.clone();
+        *p = Some(path.clone());
     }
     if let Ok(mut m) = ctx.model.lock() {
-        *m = model;
+        *m = Some(model);
     }
     if let Ok(mut s) = ctx.stats.lock() {
-        s.model = path.display().to_string();
+        s.model = super::stats::model_name(Some(&path));
     }
     tracing::info!(target: "emoshift", path = %path.display(), "model swapped in");
     Ok(())
@@ -266,8 +270,11 @@ pub(crate) async fn reload_on_sighup(ctx: ControlCtx, shutdown: CancellationToke
             tokio::select! {
                 () = shutdown.cancelled() => break,
                 _ = hup.recv() => {
-                    let path = ctx.model_path.lock().map(|p| p.clone()).ok();
-                    let Some(path) = path else { continue };
+                    let path = ctx.model_path.lock().ok().and_then(|p| p.clone());
+                    let Some(path) = path else {
+                        tracing::warn!(target: "emoshift", "SIGHUP: no model file to reload, frames pass through unedited: load one with /model/load PATH");
+                        continue;
+                    };
                     match reload(&ctx, path).await {
                         Ok(()) => {}
                         Err(e) => tracing::warn!(target: "emoshift", error = %e, "SIGHUP reload failed, old model kept: fix the model file and send SIGHUP again, or /model/load another"),

@@ -17,7 +17,7 @@ use std::sync::atomic::AtomicU64;
 use std::sync::{Arc, Mutex};
 
 use anyhow::{Context, Result};
-use engine::pipeline::{Pipeline, PipelineConfig};
+use engine::pipeline::PipelineConfig;
 use engine::{Performer, SourceFrame};
 use ica_core::model::IcaModel;
 use tokio::net::UdpSocket;
@@ -30,16 +30,16 @@ use super::monitor::{Board, Feed};
 use super::processing::{Processing, Shared};
 use super::queue::Queue;
 use super::sinks::natnet::{self as natnet_server, NatNetServer, NatNetSink};
-use super::sinks::osc::{OscOutput, OscOutputConfig};
 use super::sinks::qtm::{self as qtm_server, QtmServer, QtmSink};
-use super::sinks::recording::Recorder;
-use super::sinks::Outputs;
 use super::sources::natnet::{Link, NatNetStatus};
 use super::sources::osc::OscSource;
 use super::sources::qtm::{self, QtmConfig, QtmStatus};
 use super::sources::{Answer, Arrival, InputCounters};
-use super::stats::{log_stats, status_into, Stats};
+use super::stats::{log_stats, model_name, status_into, Stats};
 use super::Config;
+
+mod assemble;
+use assemble::{outputs, processing_pipeline};
 
 type QtmInput = (QtmConfig, Arc<InputCounters>);
 
@@ -52,7 +52,8 @@ pub struct Bound {
     control: UdpSocket,
     control_news: std::net::UdpSocket,
     config: Config,
-    model: Arc<IcaModel>,
+    /// The default model; `None`: frames pass through until one is loaded.
+    model: Option<Arc<IcaModel>>,
     performers: Vec<Performer>,
     /// The NatNet source's sockets, when one is configured, and its counters.
     natnet: Option<(Link, Arc<InputCounters>)>,
@@ -70,8 +71,11 @@ pub struct Bound {
 /// # Errors
 /// A socket that cannot be bound or a model that cannot be loaded.
 pub async fn bind(config: Config) -> Result<Bound> {
-    let model = super::load_model(config.model.clone(), config.max_model_bytes).await?;
-    bind_with(config, model).await
+    let model = match config.model.clone() {
+        Some(path) => Some(super::load_model(path, config.max_model_bytes).await?),
+        None => None,
+    };
+    bind_model(config, model.map(Arc::new)).await
 }
 
 /// [`bind`] with the default model given instead of read from `config.model` (bench, tests).
@@ -79,7 +83,11 @@ pub async fn bind(config: Config) -> Result<Bound> {
 /// # Errors
 /// A socket that cannot be bound or a performer model that cannot be loaded.
 pub async fn bind_with(config: Config, model: IcaModel) -> Result<Bound> {
-    let model = Arc::new(model);
+    bind_model(config, Some(Arc::new(model))).await
+}
+
+/// [`bind`] with the default model, if any, loaded.
+async fn bind_model(config: Config, model: Option<Arc<IcaModel>>) -> Result<Bound> {
     let performers = load_performers(&config).await?;
     let frames = super::net::bind_receiver_std(config.listen)
         .with_context(|| format!("binding the frame socket {}", config.listen))?;
@@ -228,7 +236,7 @@ impl Bound {
             cmd_tx,
             stats: Arc::clone(&stats),
             model_path: Arc::new(Mutex::new(self.config.model.clone())),
-            model: Arc::new(Mutex::new(Arc::clone(&self.model))),
+            model: Arc::new(Mutex::new(self.model.clone())),
             tracker: tracker.clone(),
             guard: Arc::new(Guard::new(&self.config)),
         };
@@ -274,59 +282,13 @@ fn new_stats(
     (natnet, qtm): (&Option<(Link, Arc<InputCounters>)>, &Option<QtmInput>),
 ) -> Arc<Mutex<Stats>> {
     let mut stats = Stats::new();
-    stats.model = config.model.display().to_string();
+    stats.model = model_name(config.model.as_deref());
     stats.inputs.push(Arc::clone(osc));
     stats
         .inputs
         .extend(natnet.as_ref().map(|n| Arc::clone(&n.1)));
     stats.inputs.extend(qtm.as_ref().map(|q| Arc::clone(&q.1)));
     Arc::new(Mutex::new(stats))
-}
-
-/// The engine over the models.
-fn processing_pipeline(
-    model: Arc<IcaModel>,
-    performers: Vec<Performer>,
-    config: &Config,
-) -> Pipeline {
-    let settings = PipelineConfig {
-        lowpass_s: config.lowpass_s,
-        ..PipelineConfig::default()
-    };
-    Pipeline::new(model, performers, settings)
-}
-
-/// Every output: the OSC subscribers, the session recording, the monitor feed when the page
-/// is served, the NatNet server when configured. A new sink is one more line here.
-fn outputs(
-    config: &Config,
-    feed: Option<Feed>,
-    (natnet, qtm): (Option<NatNetSink>, Option<QtmSink>),
-    control_news: std::net::UdpSocket,
-) -> Result<Outputs> {
-    let osc = OscOutput::new(&OscOutputConfig {
-        send: config.send.clone(),
-        max_subscribers: config.max_subscribers,
-        max_send_failures: config.max_send_failures,
-        lease: config.lease,
-        max_markers: PipelineConfig::default().max_markers,
-        vmc_names: config.vmc_names.clone(),
-    })?;
-    let mut others: Vec<Box<dyn engine::Sink + Send>> = Vec::new();
-    if let Some(natnet) = natnet {
-        others.push(Box::new(natnet));
-    }
-    if let Some(qtm) = qtm {
-        others.push(Box::new(qtm));
-    }
-    if let Some(feed) = feed {
-        others.push(Box::new(feed));
-    }
-    Ok(Outputs {
-        osc,
-        recorder: Recorder::new().telling(control_news),
-        others,
-    })
 }
 
 /// The NatNet and QTM servers' tasks when configured, their status into `/status`; their

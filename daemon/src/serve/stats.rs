@@ -340,5 +340,10 @@ pub async fn log_stats(
     }
 }
 
+/// What `/status` says of the default model: its file, or `none` (frames pass through).
+pub(crate) fn model_name(path: Option<&std::path::Path>) -> String {
+    path.map_or_else(|| "none".to_string(), |p| p.display().to_string())
+}
+
 #[cfg(test)]
 mod tests;

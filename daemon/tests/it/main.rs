@@ -8,6 +8,7 @@
 mod analysis_stream;
 mod cli;
 mod common;
+mod edit_range;
 mod emotion;
 mod emotion_captures;
 mod emotion_cli;

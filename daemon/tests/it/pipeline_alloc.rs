@@ -2,8 +2,9 @@
 //! markers missing, a live emotion edit gliding, every output profile encoded) as `serve`
 //! runs them: the OSC source's demux, the processing queue (pooled buffers, shared labels),
 //! `Pipeline::handle_frame`, the sinks: every OSC profile encoded, and the monitor page's feed
-//! open (a 30 Hz snapshot of the stream published to the board). Counted by
-//! allocation-counter's global allocator (no `unsafe` here: the workspace forbids it).
+//! open (a 30 Hz snapshot of the stream published to the board). Then the same without a model
+//! (issue 37: frames passed through unedited). Counted by allocation-counter's global
+//! allocator (no `unsafe` here: the workspace forbids it).
 
 use std::net::SocketAddr;
 use std::sync::atomic::AtomicU64;
@@ -19,6 +20,7 @@ use daemon::serve::sources::{Answer, Arrival, InputCounters};
 use engine::monitor::MonitorTap;
 use engine::pipeline::{Pipeline, PipelineConfig};
 use engine::{Needs, Processed, Sink};
+use ica_core::model::IcaModel;
 use protocol::{encode_frame_into, encode_labels_into, Control, FrameBuf, Labels};
 
 const MARKERS: usize = 109;
@@ -63,6 +65,13 @@ fn the_frame_path_does_not_allocate() {
     ] {
         p.handle_edit(&c).expect("valid edit");
     }
+    ten_thousand_frames(p, &model, "edited");
+    let passthrough = Pipeline::without_model(vec![], PipelineConfig::default());
+    ten_thousand_frames(passthrough, &model, "passed through without a model");
+}
+
+/// 200 frames to warm up, then 10,000 counted, through `p` as `serve` runs them.
+fn ten_thousand_frames(mut p: Pipeline, model: &IcaModel, what: &str) {
     let counters = Arc::new(InputCounters::named("osc"));
     let mut demux = OscDemux::new(1_000, Arc::clone(&counters));
     let (queue, ends) = Queue::new(64, 1_000, Arc::new(AtomicU64::new(0)));
@@ -84,7 +93,7 @@ fn the_frame_path_does_not_allocate() {
     let mut datagrams: Vec<Vec<u8>> = (0..16)
         .map(|f| {
             let mut xyz = vec![0.0f32; MARKERS * 3];
-            frame_into(&model, f, &mut xyz);
+            frame_into(model, f, &mut xyz);
             if f % 4 == 0 {
                 xyz[30..39].fill(f32::NAN);
             }
@@ -140,6 +149,6 @@ fn the_frame_path_does_not_allocate() {
     );
     assert_eq!(
         info.count_total, 0,
-        "allocations in 10,000 frames: {info:?}"
+        "allocations in 10,000 frames {what}: {info:?}"
     );
 }

@@ -8,6 +8,7 @@ mod faults;
 mod issue_37;
 mod monitor;
 mod natnet;
+mod no_model;
 mod regression_30;
 mod session;
 mod shutdown;

@@ -46,10 +46,15 @@ pub struct Daemon {
 }
 
 pub async fn start(model: &Path, send: Vec<String>) -> Daemon {
+    start_on(Some(model), send).await
+}
+
+/// [`start`], with no model when `model` is `None` (frames pass through unedited).
+pub async fn start_on(model: Option<&Path>, send: Vec<String>) -> Daemon {
     let raw = RawConfig {
         listen: Some("127.0.0.1:0".into()),
         control: Some("127.0.0.1:0".into()),
-        model: Some(model.to_path_buf()),
+        model: model.map(Path::to_path_buf),
         send,
         // Room for a whole test burst: these tests check that no frame is lost.
         queue: Some(4096),
@@ -150,6 +155,14 @@ impl ControlClient {
             }
         }
         None
+    }
+
+    /// A text of `/status` (the model's file, ...).
+    pub async fn status_text(&self, name: &str) -> String {
+        let pairs = self.0.status().await.expect("a status");
+        let value = pairs.iter().find(|(k, _)| k == name);
+        let text = value.and_then(|(_, v)| v.as_text());
+        text.unwrap_or_else(|| panic!("no text {name}")).to_string()
     }
 
     pub async fn status(&self, name: &str) -> i64 {

@@ -64,6 +64,12 @@ pub enum EditRefused {
         /// The weight.
         weight: f64,
     },
+    /// No model is loaded: frames pass through unedited until one is.
+    #[error(
+        "no model is loaded, frames pass through unedited: load one with /model/load PATH, or \
+         record a calibration session with `emoshift session ... --load-into`"
+    )]
+    NoModel,
     /// A target point with a number of levels other than the emotion space's dimensions.
     #[error("a target of {got} levels for an emotion space of {expected}")]
     Dims {

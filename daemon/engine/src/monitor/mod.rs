@@ -39,7 +39,8 @@ pub struct Snapshot {
     pub name: String,
     /// Frame number.
     pub frame_number: i32,
-    /// The stream's model (its labels, roles and emotion space).
+    /// The stream's model (its labels, roles and emotion space); `None` for a stream passed
+    /// through without one (markers in the source's order, no components).
     pub model: Option<Arc<IcaModel>>,
     /// Positions as received, x y z per marker (0 where missing).
     pub input: Vec<f32>,
@@ -77,12 +78,8 @@ impl Snapshot {
         self.name.clear();
         self.name.push_str(&stream.identity.name);
         self.frame_number = stream.last_frame().unwrap_or(0);
-        if !self
-            .model
-            .as_ref()
-            .is_some_and(|m| Arc::ptr_eq(m, &stream.model))
-        {
-            self.model = Some(Arc::clone(&stream.model));
+        if !stream.runs_on(self.model.as_ref()) {
+            self.model.clone_from(&stream.model);
         }
         copy(&mut self.input, stream.input());
         copy(&mut self.output, stream.edited());
@@ -91,7 +88,11 @@ impl Snapshot {
         self.flags.clear();
         let (missing, filled) = (stream.input_missing(), stream.filled());
         for (i, &gone) in missing.iter().enumerate() {
-            let filled = filled.get(i).copied().unwrap_or(gone);
+            // Without a model nothing is filled: a missing marker stays missing.
+            let filled = filled
+                .get(i)
+                .copied()
+                .unwrap_or(gone && stream.model.is_some());
             self.flags
                 .push((u8::from(gone) * FLAG_MISSING) | (u8::from(filled) * FLAG_FILLED));
         }

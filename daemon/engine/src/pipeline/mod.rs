@@ -10,6 +10,11 @@
 //! 3. between two frames (a frame boundary, so no frame sees half a change):
 //!    [`Pipeline::handle_edit`], [`Pipeline::check_model`] then [`Pipeline::set_model`];
 //! 4. every [`SWEEP_SECONDS`] on the caller's clock: [`Pipeline::forget_quiet_streams`].
+//!
+//! A pipeline made [`Pipeline::without_model`] (a stage that starts the daemon before the
+//! performer's model exists) passes every frame through unedited, under its source's labels
+//! and frame numbers, and refuses edits ([`EditRefused::NoModel`]); [`Pipeline::set_model`]
+//! later rebuilds its streams on the model, edited from their next frame.
 
 use std::sync::Arc;
 
@@ -77,6 +82,9 @@ pub const MAX_SOURCES: usize = 64;
 pub const QUIET_SWEEPS: u64 = 3;
 /// How often the shell sweeps, seconds (for the refusal's words; the shell owns the clock).
 pub const SWEEP_SECONDS: u64 = 10;
+/// Default rate of a stream passed through without a model (what its recording and the
+/// NatNet and QTM servers announce): the common facial capture rate.
+pub const DEFAULT_PASSTHROUGH_RATE_HZ: f64 = 120.0;
 
 /// Pipeline settings.
 #[derive(Debug, Clone)]
@@ -85,6 +93,8 @@ pub struct PipelineConfig {
     pub lowpass_s: f32,
     /// Largest frame accepted (markers).
     pub max_markers: usize,
+    /// The rate of streams without a model (a model's streams have its rate).
+    pub passthrough_rate_hz: f64,
 }
 
 impl Default for PipelineConfig {
@@ -92,6 +102,7 @@ impl Default for PipelineConfig {
         PipelineConfig {
             lowpass_s: crate::edit_state::DEFAULT_LOWPASS_S,
             max_markers: 1_000,
+            passthrough_rate_hz: DEFAULT_PASSTHROUGH_RATE_HZ,
         }
     }
 }
@@ -100,7 +111,8 @@ impl Default for PipelineConfig {
 #[derive(Debug)]
 pub struct Pipeline {
     config: PipelineConfig,
-    model: Arc<IcaModel>,
+    /// The default model; `None`: frames without a performer's model pass through.
+    model: Option<Arc<IcaModel>>,
     performers: Vec<Performer>,
     streams: Streams,
     /// Settings of the default model's streams, copied into new streams.
@@ -120,6 +132,22 @@ impl Pipeline {
     /// A pipeline over `model`, with optional named performers.
     pub fn new(model: Arc<IcaModel>, performers: Vec<Performer>, config: PipelineConfig) -> Self {
         let template = EditState::for_model(&model, config.lowpass_s);
+        Pipeline::with_template(Some(model), template, performers, config)
+    }
+
+    /// A pipeline with no default model yet: streams without a performer's model pass their
+    /// frames through unedited until [`Pipeline::set_model`].
+    pub fn without_model(performers: Vec<Performer>, config: PipelineConfig) -> Self {
+        let template = EditState::new(0, &[], config.lowpass_s);
+        Pipeline::with_template(None, template, performers, config)
+    }
+
+    fn with_template(
+        model: Option<Arc<IcaModel>>,
+        template: EditState,
+        performers: Vec<Performer>,
+        config: PipelineConfig,
+    ) -> Self {
         Pipeline {
             streams: Streams::new(MAX_SOURCES),
             frame_out: FrameBuf::with_max_markers(config.max_markers),
@@ -149,9 +177,10 @@ impl Pipeline {
         self.time_in = frame.time;
         let defaults = setup::Defaults {
             performers: &self.performers,
-            model: &self.model,
+            model: self.model.as_ref(),
             template: &self.template,
             lowpass_s: self.config.lowpass_s,
+            passthrough_rate_hz: self.config.passthrough_rate_hz,
         };
         let io = run::Io {
             frame_out: &mut self.frame_out,
@@ -184,6 +213,11 @@ impl Pipeline {
         }
     }
 
+    /// The default model, `None` before one is loaded.
+    pub fn model(&self) -> Option<&Arc<IcaModel>> {
+        self.model.as_ref()
+    }
+
     /// Streams now.
     pub fn stream_count(&self) -> usize {
         self.streams.len()
@@ -200,15 +234,15 @@ impl Pipeline {
     }
 
     /// Whether `model` can replace the default model: every stream running on the default
-    /// model must name all of `model`'s markers, or it would be left with markers it never
-    /// sees (or none at all).
+    /// model (or passed through for want of one) must name all of `model`'s markers, or it
+    /// would be left with markers it never sees (or none at all).
     ///
     /// # Errors
     /// The streams it does not fit and the markers each lacks.
     pub fn check_model(&self, model: &IcaModel) -> Result<(), ModelMismatch> {
         let mut streams = Vec::new();
         for (_, stream) in self.streams.iter() {
-            if !Arc::ptr_eq(&stream.model, &self.model) {
+            if !stream.runs_on(self.model.as_ref()) {
                 continue;
             }
             let missing = stream.missing_from_source(model.labels());
@@ -224,18 +258,19 @@ impl Pipeline {
 
     /// Swaps in a new default model at a frame boundary: streams on the default model are
     /// rebuilt on it, keeping their edit settings; no frame is dropped. Check it with
-    /// [`Pipeline::check_model`] first: a stream it does not fit keeps the old model.
+    /// [`Pipeline::check_model`] first: a stream it does not fit keeps the old model (or
+    /// none).
     pub fn set_model(&mut self, model: Arc<IcaModel>) {
         let mut template = EditState::for_model(&model, self.config.lowpass_s);
         template.copy_settings(&self.template);
         self.template = template;
-        let old = std::mem::replace(&mut self.model, model);
+        let old = self.model.replace(Arc::clone(&model));
         for (_, stream) in self.streams.iter_mut() {
-            if !Arc::ptr_eq(&stream.model, &old) {
+            if !stream.runs_on(old.as_ref()) {
                 continue;
             }
             // A stream whose labels share nothing with the new model keeps the old one.
-            if let Ok(fresh) = stream.rebuilt_on(Arc::clone(&self.model), self.config.lowpass_s) {
+            if let Ok(fresh) = stream.rebuilt_on(Arc::clone(&model), self.config.lowpass_s) {
                 *stream = fresh;
             }
         }
@@ -247,12 +282,20 @@ impl Pipeline {
     /// # Errors
     /// [`EditRefused`] when the default model cannot take it (component out of range, no
     /// emotion component, unknown emotion); streams of other models skip what they cannot take.
+    /// [`EditRefused::NoModel`] when there is no model to edit with (no default model, and no
+    /// performer's).
     pub fn handle_edit(&mut self, control: &Control) -> Result<(), EditRefused> {
-        let model = Arc::clone(&self.model);
-        apply_edit(&mut self.template, &model, control)?;
+        match &self.model {
+            Some(model) => apply_edit(&mut self.template, &Arc::clone(model), control)?,
+            None if self.performers.iter().all(|p| p.model.is_none()) => {
+                return Err(EditRefused::NoModel);
+            }
+            None => {}
+        }
         for (_, stream) in self.streams.iter_mut() {
-            let m = Arc::clone(&stream.model);
-            let _ = apply_edit(&mut stream.edit, &m, control);
+            if let Some(m) = stream.model.clone() {
+                let _ = apply_edit(&mut stream.edit, &m, control);
+            }
         }
         Ok(())
     }
@@ -263,7 +306,13 @@ impl Pipeline {
         if self.streams.len() >= MAX_SOURCES {
             return format!("the daemon already runs {MAX_SOURCES} streams");
         }
-        let all = self.model.labels();
+        let Some(default) = &self.model else {
+            return format!(
+                "its {} labels name no marker; send /mocap/labels with the markers' names",
+                labels.len()
+            );
+        };
+        let all = default.labels();
         let model = &all[..all.len().min(4)];
         let why = format!(
             "none of its {} markers ({}) is a marker of the model, whose markers start {}",

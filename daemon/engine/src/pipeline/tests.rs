@@ -345,3 +345,67 @@ fn a_prefixed_source_is_told_to_strip_the_prefix() {
         "{why}"
     );
 }
+
+/// Issue 37: without a model every frame passes through as received (the source's order,
+/// missing markers missing), edits are refused naming `/model/load`, and a model loaded later
+/// edits from the next frame, none dropped.
+#[test]
+fn without_a_model_frames_pass_through_until_one_is_set() {
+    let model = Arc::new(random_model(MARKERS, 4, 21));
+    let mut p = Pipeline::without_model(vec![], PipelineConfig::default());
+    assert!(p.model().is_none());
+    let refused = p.handle_edit(&Control::Target("happy".into()));
+    assert_eq!(refused, Err(EditRefused::NoModel));
+    assert!(EditRefused::NoModel.to_string().contains("/model/load"));
+    let mut src = Src::new(peer(), &model, true);
+    let mut xyz = vec![0.0; MARKERS * 3];
+    for n in 0..5 {
+        frame_into(&model, n as usize, &mut xyz);
+        xyz[3..6].fill(f32::NAN);
+        let got = src.send(&mut p, &xyz, n);
+        assert_eq!(got.len(), 1, "frame {n}");
+        assert_eq!(got[0].0, n, "same frame number");
+        // The frame as sent: `send` builds it from `xyz` in the source's (reversed) order.
+        let same = got[0]
+            .1
+            .iter()
+            .zip(&xyz)
+            .all(|(a, b)| a == b || (a.is_nan() && b.is_nan()));
+        assert!(same, "frame {n} passes through unedited");
+    }
+    let status = p.stream_status();
+    assert_eq!(
+        (status[0].model_markers, status[0].unmatched_markers),
+        (MARKERS, 0)
+    );
+    let stream = p.stream(&src.key).expect("the stream");
+    assert_eq!(stream.labels(), &src.labels[..], "the source's labels");
+    assert!(stream.components().is_empty());
+
+    let other = random_model(MARKERS + 1, 4, 2);
+    let mismatch = p
+        .check_model(&other)
+        .expect_err("the stream lacks a marker");
+    assert!(mismatch.to_string().contains("lacks 1"), "{mismatch}");
+    p.check_model(&model)
+        .expect("the stream names every marker");
+    p.set_model(Arc::clone(&model));
+    p.handle_edit(&Control::Ramp(0.0)).expect("a model now");
+    p.handle_edit(&Control::Target("happy".into()))
+        .expect("known");
+    p.handle_edit(&Control::Amount(1.0)).expect("in range");
+    frame_into(&model, 5, &mut xyz);
+    let got = src.send(&mut p, &xyz, 5);
+    assert_eq!(got.len(), 1, "the next frame is not dropped");
+    assert_eq!(p.stream(&src.key).expect("stream").labels(), model.labels());
+    // Model order now: the source sent its markers reversed.
+    let sent: Vec<f32> = xyz.chunks_exact(3).rev().flatten().copied().collect();
+    let moved = got[0]
+        .1
+        .iter()
+        .zip(&sent)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f32::max);
+    assert!(moved > 0.1, "edited from the next frame ({moved} mm)");
+    assert_eq!(p.counters.frames_out, 6);
+}

@@ -1,17 +1,21 @@
 //! One stream: a source's frames of one layout, with its own frame order, edit state,
 //! low-pass state and per-frame buffers, processed by [`Stream::process`].
+//!
+//! A stream without a model ([`Stream::passthrough`]: the daemon started before the
+//! performer's model exists) passes its frames through unedited, under the source's labels,
+//! missing markers as missing; a model loaded later rebuilds it ([`Stream::rebuilt_on`]).
 
 use std::sync::Arc;
 
 use ica_core::model::IcaModel;
-use protocol::{FrameBuf, FrameHeader, StreamTag, MAX_STREAM_NAME_BYTES};
+use protocol::{StreamTag, MAX_STREAM_NAME_BYTES};
 
 use super::edit_state::EditState;
 use super::frame::FrameProcessor;
 use super::layout::{LabelMap, LayoutError};
-use super::Counters;
 
 mod order;
+mod process;
 pub use order::{Order, RESTART_FRAMES, RESTART_RUN};
 
 /// Who a stream is to its subscribers: `/emoshift/stream ,is`.
@@ -61,8 +65,10 @@ pub struct Outcome {
 pub struct Stream {
     /// Who it is to subscribers.
     pub identity: Identity,
-    /// The model used.
-    pub model: Arc<IcaModel>,
+    /// The model used; `None`: no model, frames pass through unedited.
+    pub model: Option<Arc<IcaModel>>,
+    /// The model's rate, or the rate given to a stream without one.
+    rate_hz: f64,
     /// Performer index, if a performer owns the stream.
     pub performer: Option<usize>,
     /// The live edit.
@@ -70,7 +76,8 @@ pub struct Stream {
     /// The source's labels (shared with the source), to build the stream again on another
     /// model and to notice the source relabelling it.
     source_labels: Arc<[String]>,
-    processor: FrameProcessor,
+    /// `None` without a model.
+    processor: Option<FrameProcessor>,
     map: LabelMap,
     /// Missing flags in source order.
     source_missing: Vec<bool>,
@@ -113,13 +120,46 @@ impl Stream {
         lowpass_s: f32,
     ) -> Result<Stream, LayoutError> {
         let map = LabelMap::new(model.labels(), source_labels)?;
-        let n = model.markers();
-        let m = model.components();
-        Ok(Stream {
+        let (m, rate) = (model.components(), model.rate_hz());
+        let mut stream = Stream::with_layout(identity, map, source_labels, (m, rate));
+        stream.edit = EditState::for_model(&model, lowpass_s);
+        stream.processor = Some(FrameProcessor::new(&model));
+        stream.model = Some(model);
+        stream.performer = performer;
+        Ok(stream)
+    }
+
+    /// A stream without a model: its frames pass through unedited, in the source's order and
+    /// under its labels, announced at `rate_hz`.
+    ///
+    /// # Errors
+    /// [`LayoutError::NoCommonMarkers`] when the source names no marker.
+    pub fn passthrough(
+        identity: Identity,
+        performer: Option<usize>,
+        source_labels: &Arc<[String]>,
+        rate_hz: f64,
+    ) -> Result<Stream, LayoutError> {
+        let map = LabelMap::new(source_labels, source_labels)?;
+        let mut stream = Stream::with_layout(identity, map, source_labels, (0, rate_hz));
+        stream.performer = performer;
+        Ok(stream)
+    }
+
+    /// The buffers of a stream whose output has `map`'s markers and `m` components, at
+    /// `rate_hz`; no model yet.
+    fn with_layout(
+        identity: Identity,
+        map: LabelMap,
+        source_labels: &Arc<[String]>,
+        (m, rate_hz): (usize, f64),
+    ) -> Stream {
+        let n = map.model_to_take.len();
+        Stream {
             identity,
             frames_since_labels: 0,
-            processor: FrameProcessor::new(&model),
-            edit: EditState::for_model(&model, lowpass_s),
+            processor: None,
+            edit: EditState::new(0, &[], 0.0),
             map,
             source_labels: Arc::clone(source_labels),
             source_missing: vec![false; source_labels.len()],
@@ -134,13 +174,15 @@ impl Stream {
             duplicates: 0,
             stale: 0,
             heard_sweep: 0,
-            model,
-            performer,
-        })
+            model: None,
+            rate_hz,
+            performer: None,
+        }
     }
 
     /// This stream on `model` (a model swap): same source, performer, edit settings and frame
-    /// order, so the next frame is neither dropped nor taken for a restart.
+    /// order, so the next frame is neither dropped nor taken for a restart. A stream without a
+    /// model rebuilt on one is edited from its next frame.
     ///
     /// # Errors
     /// As [`Stream::new`].
@@ -154,6 +196,24 @@ impl Stream {
         fresh.stale = self.stale;
         fresh.heard_sweep = self.heard_sweep;
         Ok(fresh)
+    }
+
+    /// The labels of [`Stream::edited`]: the model's, or the source's without a model.
+    pub fn labels(&self) -> &[String] {
+        match &self.model {
+            Some(m) => m.labels(),
+            None => &self.source_labels,
+        }
+    }
+
+    /// The model's rate, or the rate given to a stream without a model.
+    pub fn rate_hz(&self) -> f64 {
+        self.rate_hz
+    }
+
+    /// Whether the stream runs on `model` (both `None`: neither has one).
+    pub fn runs_on(&self, model: Option<&Arc<IcaModel>>) -> bool {
+        same_model(self.model.as_ref(), model)
     }
 
     /// The components of the last processed frame, after the edit.
@@ -186,9 +246,10 @@ impl Stream {
         &self.missing
     }
 
-    /// Which markers of the last frame the model filled (missing, or rejected as glitches).
+    /// Which markers of the last frame the model filled (missing, or rejected as glitches;
+    /// none without a model).
     pub fn filled(&self) -> &[bool] {
-        self.processor.filled()
+        self.processor.as_ref().map_or(&[], |p| p.filled())
     }
 
     /// The last frame number taken.
@@ -219,114 +280,14 @@ impl Stream {
             .filter(|t| t.is_none())
             .count()
     }
+}
 
-    /// Takes one received frame through the stream into `output`: order check, markers into
-    /// model order, projection (masked where markers are missing), the live edit, and (when
-    /// `output` is `Some`: a sink reads the markers) resynthesis with the head pose put back.
-    /// `None` when the frame is dropped (counted in `counters`).
-    pub fn process(
-        &mut self,
-        header: &FrameHeader,
-        input: &FrameBuf,
-        output: Option<&mut FrameBuf>,
-        counters: &mut Counters,
-    ) -> Option<Outcome> {
-        let frames = match self.check_order(header.frame_number) {
-            Order::Next { frames } => frames,
-            Order::Restart => {
-                counters.restarts += 1;
-                1
-            }
-            Order::Duplicate => {
-                counters.dropped_duplicate += 1;
-                return None;
-            }
-            Order::Stale => {
-                counters.dropped_stale += 1;
-                return None;
-            }
-        };
-        self.gather(header, input);
-        counters.missing_markers += self.missing.iter().filter(|&&m| m).count() as u64;
-        let Ok(prepared) = self
-            .processor
-            .project(&self.xyz, &self.missing, &mut self.u)
-        else {
-            counters.frame_errors += 1;
-            return None;
-        };
-        counters.glitches += prepared.glitches as u64;
-        let rate = self.model.rate_hz();
-        // A gap of many frames moves the glides by at most a second.
-        let dt = (f64::from(frames.min(rate.max(1.0) as u32)) / rate) as f32;
-        self.u_in.copy_from_slice(&self.u);
-        self.edit.apply(dt, &mut self.u);
-        if let Some(output) = output {
-            let (pose, held) = (prepared.pose.as_ref(), prepared.status.held);
-            if !self.resynthesise(header, pose, held, output) {
-                counters.frame_errors += 1;
-                return None;
-            }
-        }
-        let labels_due =
-            self.frames_since_labels == 0 || f64::from(self.frames_since_labels) >= rate;
-        self.frames_since_labels = if labels_due {
-            1
-        } else {
-            self.frames_since_labels + 1
-        };
-        Some(Outcome {
-            frames_since_last: frames,
-            labels_due,
-        })
-    }
-
-    /// The edited components back to markers, into `self.out` and `output`; a frame too
-    /// occluded to estimate (`held`) goes out as received instead. `false` when the processor
-    /// or the frame refused (an internal invariant).
-    fn resynthesise(
-        &mut self,
-        header: &FrameHeader,
-        pose: Option<&ica_core::stabilise::Pose>,
-        held: bool,
-        output: &mut FrameBuf,
-    ) -> bool {
-        let resynthesised = self.processor.resynthesise(pose, &self.u, &mut self.out);
-        if held {
-            // Too few markers to estimate the face: what was seen goes out as received, the
-            // rest as missing, rather than the last estimate passed off as data.
-            for ((out, xyz), &gone) in self
-                .out
-                .chunks_exact_mut(3)
-                .zip(self.xyz.chunks_exact(3))
-                .zip(&self.missing)
-            {
-                if gone {
-                    out.fill(f32::NAN);
-                } else {
-                    out.copy_from_slice(xyz);
-                }
-            }
-        }
-        resynthesised.is_ok()
-            && output
-                .set_frame(header.frame_number, header.capture_time_us, &self.out)
-                .is_ok()
-    }
-
-    /// The input's markers into model order, with their missing flags.
-    fn gather(&mut self, header: &FrameHeader, input: &FrameBuf) {
-        if header.missing_count == 0 {
-            self.map
-                .gather_present_into(input.positions(), &mut self.xyz, &mut self.missing);
-        } else {
-            for (i, m) in self.source_missing.iter_mut().enumerate() {
-                *m = input.is_missing(i);
-            }
-            let (xyz, missing) = (&mut self.xyz, &mut self.missing);
-            self.map
-                .gather_into(input.positions(), &self.source_missing, xyz, missing);
-        }
+/// Whether two streams' models are the same (the same loaded model, or neither has one).
+pub fn same_model(a: Option<&Arc<IcaModel>>, b: Option<&Arc<IcaModel>>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+        (None, None) => true,
+        _ => false,
     }
 }
 

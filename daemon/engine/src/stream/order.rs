@@ -64,7 +64,9 @@ impl Stream {
             Order::Duplicate => self.duplicates += 1,
             Order::Stale => self.stale += 1,
             Order::Restart => {
-                self.processor.reset();
+                if let Some(processor) = &mut self.processor {
+                    processor.reset();
+                }
                 self.edit.reset_lowpass();
                 self.last_frame = Some(frame_number);
                 self.frames += 1;

@@ -53,6 +53,10 @@ pub struct EditRequest {
     pub add_from: Option<(PathBuf, PathBuf)>,
     /// Keep the gaps of the input instead of filling them from the model.
     pub keep_gaps: bool,
+    /// Write only the frames from this one (`--start`; the take's first when `None`).
+    pub start: Option<crate::offline::trim::FrameOrTime>,
+    /// ... to this one, inclusive (`--end`; the take's last when `None`).
+    pub end: Option<crate::offline::trim::FrameOrTime>,
 }
 
 /// A request the model cannot carry out as asked: a command-line mistake, not a failure.

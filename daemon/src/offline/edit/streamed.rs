@@ -1,5 +1,11 @@
 //! `emoshift edit` streamed: each block projected, edited, resynthesised and written before the
 //! next is read.
+//!
+//! With a range (`--start`/`--end`), the frames before it are read and edited but not written,
+//! so the low-pass, the glitch reference and the held pose reach the range as they would in
+//! the whole take, and reading stops after it: the output is the same range cut from the whole
+//! edit, its first frame numbered as in the input. A `--to-emotion` without `--lowpass` still
+//! measures the whole take's mean (its first pass), as the whole edit does.
 
 use std::path::Path;
 
@@ -13,6 +19,7 @@ use crate::offline::streamed::{
     label_map, run_pass, source_notices, with_writer, BlockWrite, Frame, FrameSink, Handoff,
     PendingOut, Source,
 };
+use crate::offline::trim::{Cut, Span};
 use engine::frame::FrameProcessor;
 
 /// What [`edit_file`] did.
@@ -52,27 +59,24 @@ pub fn edit_file(
     let map = label_map(model, &source)?;
     let notices = source_notices(model, &source, &map);
     if plan.needs_means() {
-        let mut sums = Sums(ComponentSums::new(model.components()));
-        let pass = (&mut source, &map);
-        run_pass(
+        measure(
             model,
-            pass,
+            (&mut source, &map),
             block_frames,
-            (progress, "measuring"),
-            &mut sums,
+            &mut *progress,
+            &mut plan,
         )?;
-        plan.settle(model, &sums.0);
-        source.rewind()?;
     }
     let header = source.empty_take();
+    let (span, cut, declared) = range_of(&header, source.frames(), request)?;
     let output = Output::new(&header, model.labels(), &map);
     let pending = PendingOut::new(out);
-    let at = (header.rate_hz, header.first_frame);
-    let writer = TakeWriter::create(pending.path(), &output.take.labels, at, source.frames())
+    let at = (header.rate_hz, header.first_frame + cut.from as i64);
+    let writer = TakeWriter::create(pending.path(), &output.take.labels, at, declared)
         .with_context(|| format!("{}", out.display()))?;
     let spare = output.take.clone();
     // The blocks are encoded and written on a thread of their own while the next is edited.
-    let frames = with_writer(spare, TakeOut(writer, out), |handoff| {
+    let (read, frames) = with_writer(spare, TakeOut(writer, out), |handoff| {
         let mut sink = Edit {
             editor: plan.editor(model)?,
             resynth: FrameProcessor::new(model),
@@ -80,12 +84,60 @@ pub fn edit_file(
             keep_gaps: request.keep_gaps,
             output,
             handoff,
+            cut,
+            written: 0,
         };
         let pass = (&mut source, &map);
-        run_pass(model, pass, block_frames, (progress, "editing"), &mut sink)
+        let read = run_pass(model, pass, block_frames, (progress, "editing"), &mut sink)?;
+        Ok((read, sink.written))
     })?;
+    if frames == 0 {
+        // Only a take whose length its header does not give gets here (else `check` said it).
+        bail!("{}", span.nothing_kept(Some(read)));
+    }
     pending.commit()?;
     Ok(EditSummary { frames, notices })
+}
+
+/// The range `request` writes of a take with `header`'s numbering and `frames` frames (when
+/// known), and the frames it keeps (likewise).
+///
+/// # Errors
+/// A range that keeps no frame.
+fn range_of(
+    header: &replay::Take,
+    frames: Option<usize>,
+    request: &EditRequest,
+) -> Result<(Span, Cut, Option<usize>)> {
+    let span = Span {
+        first_frame: header.first_frame,
+        rate_hz: header.rate_hz,
+    };
+    let cut = Cut::new((span.first_frame, span.rate_hz), request.start, request.end);
+    let kept = cut.check(span, frames)?;
+    Ok((span, cut, kept.map(|range| range.len())))
+}
+
+/// The first pass of a mean-based edit: the take's mean components settle `plan`; the source
+/// is rewound for the edit.
+fn measure(
+    model: &IcaModel,
+    (source, map): (&mut Source, &engine::LabelMap),
+    block_frames: usize,
+    progress: &mut dyn Progress,
+    plan: &mut super::Plan,
+) -> Result<()> {
+    let mut sums = Sums(ComponentSums::new(model.components()));
+    let pass = (&mut *source, map);
+    run_pass(
+        model,
+        pass,
+        block_frames,
+        (progress, "measuring"),
+        &mut sums,
+    )?;
+    plan.settle(model, &sums.0);
+    source.rewind()
 }
 
 /// The first pass of a mean-based edit.
@@ -107,17 +159,30 @@ struct Edit<'a> {
     keep_gaps: bool,
     output: Output<'a>,
     handoff: Handoff<replay::Take>,
+    /// The frames written (all without a range).
+    cut: Cut,
+    written: usize,
 }
 
 impl FrameSink for Edit<'_> {
     fn frame(&mut self, frame: Frame<'_>) -> Result<()> {
+        // Frames before the range are edited too: the edit's state reaches it as in the
+        // whole take.
         self.editor.apply(frame.index, frame.u)?;
+        if !self.cut.keeps(frame.index) {
+            return Ok(());
+        }
         let pose = frame.prepared.pose;
         self.resynth
             .resynthesise(pose.as_ref(), frame.u, &mut self.edited)?;
         let edited = (&self.edited[..], frame.model.1);
+        self.written += 1;
         self.output
             .push_frame(frame.index, frame.source, edited, self.keep_gaps)
+    }
+
+    fn is_past(&self, index: usize) -> bool {
+        self.cut.is_past(index)
     }
 
     fn end_block(&mut self) -> Result<()> {

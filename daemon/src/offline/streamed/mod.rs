@@ -59,6 +59,11 @@ pub(crate) trait FrameSink {
     fn end_block(&mut self) -> Result<()> {
         Ok(())
     }
+    /// Whether the sink wants no frame from index `index` on (a range ended): the pass stops
+    /// reading.
+    fn is_past(&self, _index: usize) -> bool {
+        false
+    }
 }
 
 /// [`crate::offline::take_notices`] of a source.
@@ -76,8 +81,31 @@ pub(crate) fn label_map(model: &IcaModel, source: &Source) -> Result<LabelMap> {
 /// A block read and put in model order, or why reading stopped.
 type ReadBlock = Result<(replay::Take, ModelFrames)>;
 
-/// Projects every frame of `source` in blocks of `block_frames` and hands it to `sink`;
-/// reports progress as step `name`; returns the frames seen.
+/// Projects each frame of a block (its frames in model order beside it), the first of them
+/// frame `index` of the take, and hands it to `sink`.
+fn feed(
+    (block, frames): (&replay::Take, &ModelFrames),
+    index: usize,
+    (processor, u): (&mut FrameProcessor, &mut [f32]),
+    sink: &mut dyn FrameSink,
+) -> Result<()> {
+    for k in 0..block.n_frames() {
+        let (xyz, missing) = frames.frame(k);
+        let prepared = processor.project(xyz, missing, u)?;
+        sink.frame(Frame {
+            index: index + k,
+            source: (block.frame(k), block.frame_missing(k)),
+            model: (xyz, missing),
+            prepared,
+            u,
+        })?;
+    }
+    Ok(())
+}
+
+/// Projects every frame of `source` in blocks of `block_frames` and hands it to `sink` (until
+/// the sink [`FrameSink::is_past`] the next); reports progress as step `name`; returns the
+/// frames seen.
 ///
 /// A reader thread decodes the next block (and puts it in model order) while this one
 /// processes the current: the frames are processed in order by one processor, as before, and
@@ -121,20 +149,14 @@ pub(crate) fn run_pass(
         });
         for read in full_rx {
             let (block, frames) = read?;
-            for k in 0..block.n_frames() {
-                let (xyz, missing) = frames.frame(k);
-                let prepared = processor.project(xyz, missing, &mut u)?;
-                sink.frame(Frame {
-                    index: index + k,
-                    source: (block.frame(k), block.frame_missing(k)),
-                    model: (xyz, missing),
-                    prepared,
-                    u: &mut u,
-                })?;
-            }
+            feed((&block, &frames), index, (&mut processor, &mut u), sink)?;
             index += block.n_frames();
             sink.end_block()?;
             progress.advance(block.n_frames() as u64);
+            if sink.is_past(index) {
+                // Dropping the channels ends the reader.
+                break;
+            }
             // The reader may have finished: a buffer it will not need.
             let _ = free_tx.send(block);
         }

@@ -63,8 +63,10 @@ pub struct RawConfig {
     pub listen: Option<String>,
     /// Control socket address.
     pub control: Option<String>,
-    /// Model file.
+    /// Model file; without one, frames pass through unedited until `/model/load`.
     pub model: Option<PathBuf>,
+    /// Rate announced and recorded for streams passed through without a model, Hz.
+    pub passthrough_rate_hz: Option<f64>,
     /// Static subscribers `HOST:PORT[:profile]`.
     pub send: Vec<String>,
     /// Cap on `/subscribe` subscribers.
@@ -142,8 +144,12 @@ pub struct Config {
     pub listen: SocketAddr,
     /// Control socket address.
     pub control: SocketAddr,
-    /// Model file.
-    pub model: PathBuf,
+    /// Model file; `None`: frames pass through unedited until a model is loaded
+    /// (`/model/load`).
+    pub model: Option<PathBuf>,
+    /// Rate of streams passed through without a model (their recordings, the NatNet and QTM
+    /// servers' announced rate), Hz.
+    pub passthrough_rate_hz: f64,
     /// Static subscribers.
     pub send: Vec<(SocketAddr, Profile)>,
     /// Cap on dynamic subscribers.
@@ -240,7 +246,8 @@ impl RawConfig {
         Ok(Config {
             listen,
             control,
-            model: self.model.ok_or(ConfigError::NoModel)?,
+            model: self.model,
+            passthrough_rate_hz: numbers.passthrough_rate_hz,
             send,
             max_subscribers: self
                 .max_subscribers
@@ -345,7 +352,13 @@ impl RawConfig {
         check("subscription_lease_s", ok, lease, "1..=3600")?;
         let mb = self.max_model_mb.unwrap_or(DEFAULT_MAX_MODEL_MB);
         check("max_model_mb", (1..=65_536).contains(&mb), mb, "1..=65536")?;
+        let rate = self
+            .passthrough_rate_hz
+            .unwrap_or(engine::pipeline::DEFAULT_PASSTHROUGH_RATE_HZ);
+        let ok = rate.is_finite() && (1.0..=10_000.0).contains(&rate);
+        check("passthrough_rate_hz", ok, rate, "1..=10000")?;
         Ok(Numbers {
+            passthrough_rate_hz: rate,
             lowpass_s,
             queue,
             poll_window: Duration::from_micros(poll_us),
@@ -358,6 +371,7 @@ impl RawConfig {
 
 /// The numeric settings, checked.
 struct Numbers {
+    passthrough_rate_hz: f64,
     lowpass_s: f32,
     queue: usize,
     poll_window: Duration,

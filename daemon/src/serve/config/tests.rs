@@ -57,7 +57,22 @@ fn send_entries_take_a_profile_and_bad_values_are_named() {
         .expect_err("a 5 ms window would poll most of the period")
         .to_string()
         .contains("poll_window_us"));
-    assert_eq!(RawConfig::default().validate(), Err(ConfigError::NoModel));
+    // Without a model the daemon starts and passes frames through (issue 37).
+    let none = RawConfig::default().validate().expect("no model is valid");
+    assert_eq!(none.model, None);
+    assert_eq!(
+        none.passthrough_rate_hz,
+        engine::pipeline::DEFAULT_PASSTHROUGH_RATE_HZ
+    );
+    let zero = RawConfig {
+        passthrough_rate_hz: Some(0.0),
+        ..RawConfig::default()
+    };
+    assert!(zero
+        .validate()
+        .expect_err("a rate of 0")
+        .to_string()
+        .contains("passthrough_rate_hz"));
 }
 
 #[test]

@@ -197,7 +197,7 @@ fn tell_model(m: &Monitor, id: i32, model: &Arc<IcaModel>) {
     {
         return;
     }
-    let default = m.ctx.model.lock().map(|d| Arc::clone(&d)).ok();
+    let default = m.ctx.model.lock().ok().and_then(|d| d.clone());
     let file = match default.is_some_and(|d| Arc::ptr_eq(&d, model)) {
         true => m.stats.lock().ok().map(|s| s.model.clone()),
         false => None,
@@ -231,7 +231,7 @@ fn status(m: &Monitor, latency: &mut Latency, sample: bool) {
 
 /// Sends the default model's emotions (the page's buttons) when the model changed.
 fn tell_emotions(m: &Monitor) {
-    let Some(model) = m.ctx.model.lock().ok().map(|d| Arc::clone(&d)) else {
+    let Some(model) = m.ctx.model.lock().ok().and_then(|d| d.clone()) else {
         return;
     };
     let Ok(mut known) = m.hub.known.lock() else {

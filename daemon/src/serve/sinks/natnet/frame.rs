@@ -48,7 +48,7 @@ struct StreamOut {
     id: i32,
     name: String,
     raw_name: String,
-    model: Arc<IcaModel>,
+    model: Option<Arc<IcaModel>>,
     /// The source's labels it was made with (a relabelled source makes it again).
     source_labels: (usize, usize),
     marker_names: Vec<String>,
@@ -165,7 +165,7 @@ impl Streams {
         let found = self.list.iter().position(|s| s.id == id);
         if let Some(i) = found {
             let s = &self.list[i];
-            if Arc::ptr_eq(&s.model, &f.stream.model)
+            if f.stream.runs_on(s.model.as_ref())
                 && s.source_labels == source_labels
                 && s.name == f.identity().name
             {
@@ -180,7 +180,7 @@ impl Streams {
             id,
             raw_name: format!("{name}_raw"),
             name,
-            model: Arc::clone(&f.stream.model),
+            model: f.stream.model.clone(),
             source_labels,
             marker_names,
             positions: vec![[f32::NAN; 3]; n],

@@ -1,6 +1,7 @@
 //! What the OSC output sends about each stream besides its frames: its `/mocap/labels` (model
 //! order, layout id = stream id) and the VMC blend names of its labelled components, made
-//! once per stream and model (a model swap makes them again).
+//! once per stream and model (a model swap makes them again). A stream without a model has
+//! its source's labels and no blend names.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -14,7 +15,8 @@ use protocol::{encode_labels_into, Labels};
 #[derive(Debug)]
 pub struct StreamNames {
     id: i32,
-    model: Arc<IcaModel>,
+    /// `None`: the stream passes its frames through without a model.
+    model: Option<Arc<IcaModel>>,
     /// `/mocap/labels` of the stream (empty when a label cannot be sent).
     pub labels_msg: Vec<u8>,
     /// VMC blend names of the labelled components (`/VMC/Ext/Blend/Val`).
@@ -44,15 +46,15 @@ impl Names {
     /// The names of `frame`'s stream, made on its first frame or after a model swap.
     pub fn of(&mut self, frame: &Processed<'_>) -> &StreamNames {
         self.frames += 1;
-        let (id, model) = (frame.identity().id, &frame.stream.model);
+        let id = frame.identity().id;
         let at = match self.streams.iter().position(|s| s.id == id) {
-            Some(i) if Arc::ptr_eq(&self.streams[i].model, model) => i,
+            Some(i) if frame.stream.runs_on(self.streams[i].model.as_ref()) => i,
             Some(i) => {
-                self.streams[i] = StreamNames::new(id, model, &self.rename);
+                self.streams[i] = StreamNames::of(id, frame, &self.rename);
                 i
             }
             None if self.streams.len() < MAX_SOURCES => {
-                self.streams.push(StreamNames::new(id, model, &self.rename));
+                self.streams.push(StreamNames::of(id, frame, &self.rename));
                 self.used.push(0);
                 self.streams.len() - 1
             }
@@ -60,7 +62,7 @@ impl Names {
                 let oldest = (0..self.used.len())
                     .min_by_key(|&i| self.used[i])
                     .unwrap_or(0);
-                self.streams[oldest] = StreamNames::new(id, model, &self.rename);
+                self.streams[oldest] = StreamNames::of(id, frame, &self.rename);
                 oldest
             }
         };
@@ -70,10 +72,20 @@ impl Names {
 }
 
 impl StreamNames {
-    fn new(id: i32, model: &Arc<IcaModel>, rename: &HashMap<String, String>) -> StreamNames {
+    fn of(id: i32, frame: &Processed<'_>, rename: &HashMap<String, String>) -> StreamNames {
+        StreamNames::new(id, frame.stream.model.as_ref(), frame.labels(), rename)
+    }
+
+    /// The names of stream `id` on `model` (none: its source's `labels`, no blend names).
+    fn new(
+        id: i32,
+        model: Option<&Arc<IcaModel>>,
+        labels: &[String],
+        rename: &HashMap<String, String>,
+    ) -> StreamNames {
         let labels = Labels {
             layout_id: id,
-            names: model.labels().to_vec(),
+            names: labels.to_vec(),
         };
         let mut labels_msg = Vec::new();
         if encode_labels_into(&labels, &mut labels_msg).is_err() {
@@ -81,9 +93,11 @@ impl StreamNames {
         }
         StreamNames {
             id,
-            model: Arc::clone(model),
+            model: model.cloned(),
             labels_msg,
-            vmc: vmc_names(model)
+            vmc: model
+                .map(|m| vmc_names(m))
+                .unwrap_or_default()
                 .into_iter()
                 .map(|(name, k)| (rename.get(&name).cloned().unwrap_or(name), k))
                 .collect(),

@@ -18,7 +18,7 @@ struct Slot {
     key: StreamKey,
     id: i32,
     name: String,
-    model: Arc<IcaModel>,
+    model: Option<Arc<IcaModel>>,
     /// The source's labels it was made with (a relabelled source makes it again).
     source_labels: (usize, usize),
     labels: Vec<String>,
@@ -96,7 +96,7 @@ impl Layout {
         let found = self.slots.iter().position(|s| s.id == id);
         if let Some(i) = found {
             let s = &self.slots[i];
-            if Arc::ptr_eq(&s.model, &f.stream.model)
+            if f.stream.runs_on(s.model.as_ref())
                 && s.source_labels == source_labels
                 && s.name == f.identity().name
             {
@@ -107,7 +107,7 @@ impl Layout {
             key: f.key,
             id,
             name: f.identity().name.clone(),
-            model: Arc::clone(&f.stream.model),
+            model: f.stream.model.clone(),
             source_labels,
             labels: f.labels().to_vec(),
             start: 0,

@@ -40,7 +40,8 @@ fn vmc_names_rename_the_blend_names_a_receiver_wants() {
         model.set_role(k, role).expect("in range");
     }
     let rename = [("emotion".to_string(), "Joy".to_string())].into();
-    let names = StreamNames::new(0, &Arc::new(model), &rename);
+    let model = Arc::new(model);
+    let names = StreamNames::new(0, Some(&model), model.labels(), &rename);
     let got: Vec<(&str, usize)> = names.vmc.iter().map(|(n, k)| (n.as_str(), *k)).collect();
     assert_eq!(got, [("Joy", 0), ("speech", 1), ("eyelids", 2)]);
 }
