@@ -23,7 +23,7 @@ frame is lost, or the last minute's p99 is more than 4 times minute 1's and 10 m
 (latency building up; this receiver's own jitter is a few ms).
 
 Why RSS is judged over the second half: the daemon's live heap stays flat (heaptrack over 7
-minutes with a rotation and a reload each minute: 2.5-2.9 MB in use throughout), but its RSS
+minutes with a rotation and a reload each minute: 2.4-3.0 MB in use throughout), but its RSS
 steps up over the first rotations and reloads, as the allocator's per-thread arenas and the
 binary's code pages (about 7 of its 11 MB of text) are touched for the first time, and then
 holds. A leak grows all run long; that warm-up does not. `anon_MB` (RssAnon: heap, arenas,
