@@ -7,6 +7,8 @@
 //! file = "s03_happy.c3d"   # relative to the manifest
 //! sentence = "s03"
 //! emotion = "happy"
+//! start = 240              # optional: first frame kept, a frame number or "2.5s"
+//! end = "6.5s"             # optional: last frame kept, inclusive
 //! ```
 //!
 //! ```toml
@@ -18,8 +20,16 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use globset::{Glob, GlobBuilder, GlobMatcher};
+use globset::{Glob, GlobMatcher};
 use serde::{Deserialize, Serialize};
+
+mod near;
+mod range;
+mod take;
+pub use range::{FrameOrTime, RangeError, TakeRange};
+pub use take::SessionTake;
+
+use near::near_labels;
 
 /// File name of the session manifest inside a session folder.
 pub const SESSION_FILE: &str = "session.toml";
@@ -74,6 +84,14 @@ pub enum SessionError {
     /// Two takes name the same file.
     #[error("take file {0:?} is listed twice")]
     DuplicateFile(String),
+    /// A take's `start`/`end` cannot be right whatever the take holds.
+    #[error("take {file:?}")]
+    BadRange {
+        /// The take's file, as listed.
+        file: String,
+        /// What is wrong with the range.
+        source: RangeError,
+    },
     /// A region has an empty name or no pattern.
     #[error("region {0:?} must have a name and at least one label or pattern")]
     EmptyRegionSpec(String),
@@ -130,18 +148,6 @@ fn read(path: &Path) -> Result<String, SessionError> {
     )?)
 }
 
-/// One take of a session.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SessionTake {
-    /// Take file, relative to the manifest (or absolute).
-    pub file: String,
-    /// Sentence id; takes with the same id say the same thing.
-    pub sentence: String,
-    /// Emotion name.
-    pub emotion: String,
-}
-
 /// A session manifest: the takes of a recording session and their labels.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -184,7 +190,8 @@ impl Session {
         Ok(session)
     }
 
-    /// Checks the rate, that there is a take, that no field is empty and no file repeats.
+    /// Checks the rate, that there is a take, that no field is empty, no file repeats and no
+    /// range ends before it starts (a range is checked against its take when the take is read).
     ///
     /// # Errors
     /// The first broken rule.
@@ -208,6 +215,12 @@ impl Session {
             if self.takes[..index].iter().any(|o| o.file == t.file) {
                 return Err(SessionError::DuplicateFile(t.file.clone()));
             }
+            t.range()
+                .check_order()
+                .map_err(|source| SessionError::BadRange {
+                    file: t.file.clone(),
+                    source,
+                })?;
         }
         Ok(())
     }
@@ -340,51 +353,6 @@ impl Regions {
             out.insert(name.clone(), idx);
         }
         Ok(out)
-    }
-}
-
-/// Labels shown at most by [`near_labels`].
-const NEAR_SHOWN: usize = 6;
-
-/// For a region that matched nothing: the labels its `patterns` match ignoring case (labels
-/// are case-sensitive: `ROOT-*` does not match `root-1`), or else the first of the take's
-/// labels, so the message shows what to write.
-fn near_labels<S: AsRef<str>>(labels: &[S], patterns: &[String]) -> String {
-    let folded: Vec<GlobMatcher> = patterns
-        .iter()
-        .filter_map(|p| {
-            GlobBuilder::new(p)
-                .case_insensitive(true)
-                .build()
-                .ok()
-                .map(|g| g.compile_matcher())
-        })
-        .collect();
-    let near: Vec<&str> = labels
-        .iter()
-        .map(AsRef::as_ref)
-        .filter(|l| folded.iter().any(|m| m.is_match(l)))
-        .collect();
-    let list = |shown: &[&str]| {
-        let mut text = shown
-            .iter()
-            .take(NEAR_SHOWN)
-            .map(|l| format!("{l:?}"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        if shown.len() > NEAR_SHOWN {
-            text.push_str(&format!(" and {} more", shown.len() - NEAR_SHOWN));
-        }
-        text
-    };
-    if near.is_empty() {
-        let all: Vec<&str> = labels.iter().map(AsRef::as_ref).collect();
-        format!("; its markers are {}", list(&all))
-    } else {
-        format!(
-            "; labels are case-sensitive, and the take has {}",
-            list(&near)
-        )
     }
 }
 

@@ -67,3 +67,27 @@ fn manifests_reject_bad_input_and_resolve_paths() {
     assert_eq!(r["mouth"], vec![0]);
     assert_eq!(r["brows"], vec![1]);
 }
+
+#[test]
+fn issue_37_take_ranges_parse_round_trip_and_refuse_a_backwards_range() {
+    let take = "[[take]]\nfile = \"a.c3d\"\nsentence = \"s01\"\nemotion = \"happy\"\n";
+    let text = format!("rate_hz = 120\n{take}start = 240\nend = \"6.5s\"\n");
+    let session = Session::parse(&text).expect("parses");
+    let range = session.takes[0].range();
+    assert_eq!(range.start, Some(FrameOrTime::Frame(240)));
+    assert_eq!(range.end, Some(FrameOrTime::Seconds(6.5)));
+    let again = Session::parse(&session.to_toml().expect("writes")).expect("reads back");
+    assert_eq!(again, session);
+    let whole = Session::parse(&format!("rate_hz = 120\n{take}")).expect("parses");
+    assert!(whole.takes[0].range().is_whole());
+    assert!(!whole.to_toml().expect("writes").contains("start"));
+
+    let backwards = format!("rate_hz = 120\n{take}start = \"3s\"\nend = \"1.5s\"\n");
+    let err = Session::parse(&backwards).expect_err("end before start");
+    assert!(matches!(err, SessionError::BadRange { .. }), "{err}");
+    let text = chain(&err);
+    assert!(text.contains("\"a.c3d\"") && text.contains("end = 1.5s is before start = 3s"));
+    let float = format!("rate_hz = 120\n{take}start = 2.5\n");
+    let err = chain(&Session::parse(&float).expect_err("a bare float"));
+    assert!(err.contains("\"2.5s\""), "says what to write: {err}");
+}

@@ -93,10 +93,12 @@ pub fn generate_session(params: &SynthParams, format: Format) -> Result<SynthSes
         rate_hz: params.rate_hz,
         takes: rendered
             .iter()
-            .map(|r| SessionTake {
-                file: format!("{}.{}", r.truth.name, format.extension()),
-                sentence: r.truth.sentence.clone(),
-                emotion: r.truth.emotion.clone(),
+            .map(|r| {
+                SessionTake::whole(
+                    format!("{}.{}", r.truth.name, format.extension()),
+                    r.truth.sentence.clone(),
+                    r.truth.emotion.clone(),
+                )
             })
             .collect(),
         base_dir: PathBuf::new(),

@@ -60,10 +60,12 @@ impl InjectedSession {
             takes: self
                 .cuts
                 .iter()
-                .map(|c| SessionTake {
-                    file: format!("{}.{}", c.name, format.extension()),
-                    sentence: c.sentence.clone(),
-                    emotion: c.emotion.clone(),
+                .map(|c| {
+                    SessionTake::whole(
+                        format!("{}.{}", c.name, format.extension()),
+                        c.sentence.clone(),
+                        c.emotion.clone(),
+                    )
                 })
                 .collect(),
             base_dir: PathBuf::new(),

@@ -329,10 +329,8 @@ impl Sitting {
             .iter()
             .zip(&self.accepted)
             .filter(|(_, &a)| a)
-            .map(|(p, _)| SessionTake {
-                file: p.file_name(&self.ext),
-                sentence: p.sentence_id(),
-                emotion: p.emotion.clone(),
+            .map(|(p, _)| {
+                SessionTake::whole(p.file_name(&self.ext), p.sentence_id(), p.emotion.clone())
             })
             .collect();
         (!takes.is_empty()).then(|| Session {
