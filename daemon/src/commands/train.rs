@@ -1,6 +1,6 @@
 //! `emoshift train`: learn an ICA model from takes.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -131,8 +131,8 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
         // A manifest declares its session's rate: the model's, unless --rate says otherwise.
         options.prep.rate_hz = Some(offline::load_session(manifest)?.rate_hz);
     }
-    let paths = offline::input_paths(args.manifest.as_deref(), &args.files)?;
-    let mut inputs: Vec<&Path> = paths.iter().map(PathBuf::as_path).collect();
+    let takes = offline::take_inputs(args.manifest.as_deref(), &args.files)?;
+    let mut inputs: Vec<&Path> = takes.iter().map(|t| t.path.as_path()).collect();
     inputs.extend(args.manifest.as_deref());
     offline::output::check_out(&args.out, &inputs, args.force)?;
     offline::output::check_out_format(&args.out, "json")?;
@@ -143,9 +143,9 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     };
     let started = Instant::now();
     let mut progress = super::progress::for_stderr("train");
-    let trained = training::train_files(&paths, &options, &stream, progress.as_mut());
+    let trained = training::train_files(&takes, &options, &stream, progress.as_mut());
     let trained = super::progress::settle(progress.as_mut(), trained)?;
-    save_and_print(trained, paths.len(), &args.out, started).map(drop)
+    save_and_print(trained, takes.len(), &args.out, started).map(drop)
 }
 
 /// Trains on `takes` held in memory, writes the model to `out` and prints what training

@@ -85,36 +85,6 @@ pub fn load_session(path: &Path) -> Result<Session> {
     Ok(Session::load(path)?)
 }
 
-/// The input files of a command, without reading them: the files given, then the manifest's
-/// takes.
-///
-/// # Errors
-/// No input, or a manifest that cannot be read.
-pub fn input_paths(manifest: Option<&Path>, files: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    let mut paths: Vec<PathBuf> = files.to_vec();
-    if let Some(manifest) = manifest {
-        paths.extend(load_session(manifest)?.take_paths());
-    }
-    if paths.is_empty() {
-        bail!("no takes given: pass --manifest session.toml or take files");
-    }
-    Ok(paths)
-}
-
-/// The input takes of a command: the manifest's takes, or the files given.
-///
-/// # Errors
-/// No input, or any take that cannot be loaded.
-pub fn load_inputs(manifest: Option<&Path>, files: &[PathBuf]) -> Result<Vec<LoadedTake>> {
-    input_paths(manifest, files)?
-        .into_iter()
-        .map(|path| {
-            let take = load_take(&path)?;
-            Ok(LoadedTake { path, take })
-        })
-        .collect()
-}
-
 /// A take in a model's marker order: frames x model markers x 3, and the missing mask.
 #[derive(Debug, Clone)]
 pub struct ModelFrames {

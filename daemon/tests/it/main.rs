@@ -22,6 +22,7 @@ mod repair_cli;
 mod replay_cli;
 mod safety;
 mod streamed;
+mod take_range;
 mod train_stream;
 mod transfer;
 mod unseen_faces;

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use daemon::offline::progress::Silent;
 use daemon::offline::training::{self, StreamOptions, TrainOptions, Trained};
-use daemon::offline::{self, LoadedTake};
+use daemon::offline::{self, LoadedTake, TakeInput};
 
 use crate::common::p as s;
 
@@ -36,13 +36,18 @@ fn in_memory(paths: &[PathBuf], options: &TrainOptions) -> Trained {
     training::train(&takes, options, &mut |_| {}).expect("trains in memory")
 }
 
+/// Files used whole.
+fn inputs(paths: &[PathBuf]) -> Vec<TakeInput> {
+    paths.iter().cloned().map(TakeInput::from).collect()
+}
+
 fn streamed(paths: &[PathBuf], options: &TrainOptions, threads: usize) -> Trained {
     let stream = StreamOptions {
         threads,
         always_stream: true,
         hold_frames: None,
     };
-    training::train_files(paths, options, &stream, &mut Silent).expect("trains streaming")
+    training::train_files(&inputs(paths), options, &stream, &mut Silent).expect("trains streaming")
 }
 
 /// The models agree: the same preparation and PCA, and mixing columns within `tol` of the
@@ -167,7 +172,8 @@ fn a_short_session_guessed_long_from_its_file_sizes_still_trains_in_memory() {
         always_stream: false,
         hold_frames: Some(2 * frames),
     };
-    let got = training::train_files(&paths, &options, &stream, &mut Silent).expect("trains");
+    let got =
+        training::train_files(&inputs(&paths), &options, &stream, &mut Silent).expect("trains");
     let want = in_memory(&paths, &options);
     // The in-memory path on the same takes: the same numbers, not merely close ones.
     let apart = (got.model.mixing() - want.model.mixing()).amax();

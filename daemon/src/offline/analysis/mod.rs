@@ -165,7 +165,7 @@ pub struct SessionTake {
     pub projected: Projected,
 }
 
-/// Loads and projects every take of a manifest.
+/// Loads and projects every take of a manifest, each cut to its range.
 ///
 /// # Errors
 /// Unreadable takes, or a take sharing no marker with the model.
@@ -173,10 +173,10 @@ pub fn project_session(model: &IcaModel, session: &Session) -> Result<Vec<Sessio
     session
         .takes
         .iter()
-        .map(|entry| {
-            let path = session.path_of(entry);
-            let take = offline::load_take(&path)?;
-            let map = offline::match_take(model, &take, &path)?;
+        .zip(offline::session_inputs(session))
+        .map(|(entry, input)| {
+            let take = input.load(replay::C3dDecoding::CrossChecked)?;
+            let map = offline::match_take(model, &take, &input.path)?;
             let projected = offline::project_take(model, &offline::to_model_order(&take, &map))?;
             Ok(SessionTake {
                 file: entry.file.clone(),

@@ -11,14 +11,19 @@
 //! 3. The few takes the timeline chart draws (at most ten), again: which ones depends on the
 //!    emotion levels, also known only at the end.
 //!
+//! A take the manifest trims (`start`/`end`) is loaded whole, cut, and projected as
+//! [`super::project_session`] does: its first kept frame starts the processor's state, as in a
+//! take written by `convert --start/--end`. One take is held at a time, never the session.
+//!
 //! [`FrameProcessor`]: engine::frame::FrameProcessor
 
 use std::collections::BTreeMap;
-use std::path::Path;
 
 use anyhow::{bail, Result};
 use ica_core::model::IcaModel;
 use replay::session::Session;
+
+use crate::offline::TakeInput;
 
 use super::stats::{SessionStats, TakeSeries};
 use super::svg::{timeline_takes, TimelineTake};
@@ -40,7 +45,8 @@ pub fn analyze_session(
     progress: &mut dyn Progress,
 ) -> Result<(Report, Vec<TimelineTake>)> {
     let model = inputs.model;
-    let frames = take_frames(session, progress)?;
+    let takes_in: Vec<TakeInput> = crate::offline::session_inputs(session).collect();
+    let frames = take_frames(&takes_in, progress)?;
     let longest = frames.iter().copied().max().unwrap_or(0);
     let mut stats = SessionStats::new(model.components(), longest);
     progress.step("analysing", "takes", Some(session.takes.len() as u64));
@@ -48,7 +54,7 @@ pub fn analyze_session(
         let series: Vec<Vec<f64>> = group
             .iter()
             .map(|&i| {
-                let u = project(model, &session.path_of(&session.takes[i]), frames[i])?;
+                let u = project(model, &takes_in[i], frames[i])?;
                 check_length(session, i, u.len() / model.components(), frames[i])?;
                 progress.advance(1);
                 Ok(u.into_iter().map(f64::from).collect())
@@ -79,20 +85,21 @@ pub fn analyze_session(
         timeline.push(TimelineTake {
             sentence: entry.sentence.clone(),
             emotion: entry.emotion.clone(),
-            u: project(model, &session.path_of(entry), frames[i])?,
+            u: project(model, &takes_in[i], frames[i])?,
         });
         progress.advance(1);
     }
     Ok((report, timeline))
 }
 
-/// Each take's frame count, from its header when it declares one, else by reading it.
-fn take_frames(session: &Session, progress: &mut dyn Progress) -> Result<Vec<usize>> {
-    progress.step("reading headers", "takes", Some(session.takes.len() as u64));
-    let mut frames = Vec::with_capacity(session.takes.len());
-    for entry in &session.takes {
-        let path = session.path_of(entry);
-        let mut source = Source::open(&path, input_limit())?;
+/// Each take's frame count (of its range), from its header when it declares one, else by
+/// reading it.
+fn take_frames(inputs: &[TakeInput], progress: &mut dyn Progress) -> Result<Vec<usize>> {
+    progress.step("reading headers", "takes", Some(inputs.len() as u64));
+    let mut frames = Vec::with_capacity(inputs.len());
+    for input in inputs {
+        let path = &input.path;
+        let mut source = Source::open(path, input_limit())?;
         let n = match source.frames() {
             Some(n) => n,
             None => {
@@ -106,7 +113,8 @@ fn take_frames(session: &Session, progress: &mut dyn Progress) -> Result<Vec<usi
         if n == 0 {
             bail!("{}: take has no frames", path.display());
         }
-        frames.push(n);
+        let head = source.empty_take();
+        frames.push(input.frames(head.first_frame, head.rate_hz, n)?.len());
         progress.advance(1);
     }
     Ok(frames)
@@ -150,9 +158,16 @@ impl FrameSink for Components {
     }
 }
 
-/// The components of one take of `frames` frames (frames x m), read in blocks.
-fn project(model: &IcaModel, path: &Path, frames: usize) -> Result<Vec<f32>> {
-    let mut source = Source::open(path, input_limit())?;
+/// The components of one take of `frames` frames (frames x m), read in blocks; a trimmed take
+/// is loaded and cut first (see the module docs).
+fn project(model: &IcaModel, input: &TakeInput, frames: usize) -> Result<Vec<f32>> {
+    if !input.range.is_whole() {
+        let take = input.load(replay::C3dDecoding::CrossChecked)?;
+        let map = crate::offline::match_take(model, &take, &input.path)?;
+        let model_frames = crate::offline::to_model_order(&take, &map);
+        return Ok(crate::offline::project_take(model, &model_frames)?.u);
+    }
+    let mut source = Source::open(&input.path, input_limit())?;
     let map = streamed::label_map(model, &source)?;
     // `frames` comes from the header, which may lie: reserve at most one block up front and
     // let the read show the true length (checked against the header afterwards).

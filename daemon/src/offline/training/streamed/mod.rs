@@ -31,7 +31,6 @@ mod spill;
 mod whitened;
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use ica_core::measure::{
@@ -43,7 +42,7 @@ use super::capture::{self, RefResiduals};
 use super::model::{capped_at_noise, component_params};
 use super::{Stage, TrainOptions, Trained};
 use crate::offline::progress::Progress;
-use crate::offline::{load_take_with, LoadedTake};
+use crate::offline::{LoadedTake, TakeInput};
 use collect::Collected;
 use finish::{fitted_model, measured, prep_report};
 use rayon::prelude::*;
@@ -79,14 +78,14 @@ pub struct StreamOptions {
     pub hold_frames: Option<usize>,
 }
 
-/// Trains a model on the takes in `paths`, streaming them unless the session is short (see
+/// Trains a model on `takes` (each cut to its range), streaming them unless the session is short (see
 /// the module docs).
 ///
 /// # Errors
 /// An unreadable take, preparation or the fit refusing the data, a spill file failing, or a
 /// fitted model that fails validation.
 pub fn train_files(
-    paths: &[PathBuf],
+    takes: &[TakeInput],
     options: &TrainOptions,
     stream: &StreamOptions,
     progress: &mut dyn Progress,
@@ -100,21 +99,21 @@ pub fn train_files(
     } else {
         stream.hold_frames.unwrap_or(IN_MEMORY_FRAMES)
     };
-    let mut scanned = scan::scan(paths, &options.prep, hold, SAMPLE_FRAMES, &pool, progress)?;
+    let mut scanned = scan::scan(takes, &options.prep, hold, SAMPLE_FRAMES, &pool, progress)?;
     if scanned.held.is_none() && scanned.total_frames() <= hold {
         // The scan guessed the session long from its files' sizes: read it again to hold it,
         // so which path trains a session depends on its frames only.
         progress.step("reading takes again to hold them", "takes", None);
-        let takes = paths
+        let held = takes
             .iter()
-            .map(|p| {
+            .map(|t| {
                 Ok(LoadedTake {
-                    path: p.clone(),
-                    take: load_take_with(p, DECODING)?,
+                    path: t.path.clone(),
+                    take: t.load(DECODING)?,
                 })
             })
             .collect::<Result<Vec<_>>>()?;
-        scanned.held = Some(takes);
+        scanned.held = Some(held);
     }
     if let Some(takes) = &scanned.held {
         let mut stage = |s: Stage| match s {

@@ -5,8 +5,6 @@
 //! a spill file, so the next pass reads them back instead of decoding every file again. A
 //! session no longer than the in-memory limit is kept whole, for the in-memory path.
 
-use std::path::PathBuf;
-
 use anyhow::{Context, Result};
 use rayon::ThreadPool;
 
@@ -16,7 +14,7 @@ use super::spill::{f32_bytes, Spill};
 use crate::offline::progress::Progress;
 use crate::offline::takes::frames_in_model_order;
 use crate::offline::training::{MissingCounts, PrepOptions};
-use crate::offline::{load_take_with, LoadedTake, ModelFrames};
+use crate::offline::{LoadedTake, ModelFrames, TakeInput};
 use engine::layout::LabelMap;
 
 /// Bytes of take files loaded at once in the first pass.
@@ -88,28 +86,28 @@ impl Scan {
 /// No take, an unreadable take, a take that shares no marker with the first, or every marker
 /// missing too often.
 pub(super) fn scan(
-    paths: &[PathBuf],
+    takes: &[TakeInput],
     prep: &PrepOptions,
     hold_frames: usize,
     sample_frames: usize,
     pool: &ThreadPool,
     progress: &mut dyn Progress,
 ) -> Result<Scan> {
-    progress.step("reading takes", "takes", Some(paths.len() as u64));
-    let first_path = paths.first().context("no takes given")?;
-    let first = load_take_with(first_path, super::DECODING)?;
+    progress.step("reading takes", "takes", Some(takes.len() as u64));
+    let first = takes.first().context("no takes given")?;
+    let first = first.load(super::DECODING)?;
     let rate_hz = prep.rate_hz.unwrap_or(first.rate_hz);
     let first_labels = first.labels.clone();
-    let sizes = file_sizes(paths);
-    let (hold, sample_guess) = session_guess(paths, &sizes, &first, rate_hz, hold_frames);
+    let sizes = file_sizes(takes);
+    let (hold, sample_guess) = session_guess(takes, &sizes, &first, rate_hz, hold_frames);
     drop(first);
     let mut counts = MissingCounts::new(first_labels.clone());
     let mut sampler = Sampler::new(sample_frames, sample_guess);
-    let mut scan = Scan::new(rate_hz, paths.len(), first_labels.len(), hold);
+    let mut scan = Scan::new(rate_hz, takes.len(), first_labels.len(), hold);
     let mut bytes = Vec::new();
     let mut raw = Spill::new(first_labels.len() * 13)?;
     let load = |i: usize| {
-        let take = load_take_with(&paths[i], super::DECODING)?;
+        let take = takes[i].load(super::DECODING)?;
         let at_rate = at_rate(&take, rate_hz);
         Ok((take, at_rate))
     };
@@ -119,7 +117,7 @@ pub(super) fn scan(
         &load,
         &mut |range, loaded| {
             for (i, (original, at_rate)) in range.zip(loaded) {
-                let path = &paths[i];
+                let path = &takes[i].path;
                 if at_rate.is_some() {
                     scan.resampled
                         .push((path.display().to_string(), original.rate_hz, rate_hz));
@@ -149,10 +147,10 @@ pub(super) fn scan(
 }
 
 /// Each file's size in bytes (1 when it cannot be read: the reading will say why).
-fn file_sizes(paths: &[PathBuf]) -> Vec<u64> {
-    paths
+fn file_sizes(takes: &[TakeInput]) -> Vec<u64> {
+    takes
         .iter()
-        .map(|p| std::fs::metadata(p).map_or(1, |m| m.len()))
+        .map(|t| std::fs::metadata(&t.path).map_or(1, |m| m.len()))
         .collect()
 }
 
@@ -174,7 +172,7 @@ fn first_take_order(
 /// Whether to hold the takes (the session looks short), and the sampler's guess at the
 /// session's frames.
 fn session_guess(
-    paths: &[PathBuf],
+    takes: &[TakeInput],
     sizes: &[u64],
     first: &replay::Take,
     rate_hz: f64,
@@ -191,10 +189,10 @@ fn session_guess(
     // take among CSV or TRC ones (several times the bytes per frame) would make the guess, and
     // the stride, several times too large, and the sample that much too small. Otherwise the
     // stride only doubles, which keeps at least half the budget.
-    let first_path = &paths[0];
-    let alike = paths
+    let first_path = &takes[0].path;
+    let alike = takes
         .iter()
-        .all(|p| p.extension() == first_path.extension());
+        .all(|t| t.path.extension() == first_path.extension());
     (hold, if alike { likely_frames } else { 0.0 })
 }
 
