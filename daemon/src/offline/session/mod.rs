@@ -15,7 +15,7 @@ pub mod check;
 pub mod script;
 
 use protocol::{SessionControl, SessionStatus};
-use replay::session::{Session, SessionTake};
+use replay::session::{Session, SessionTake, TakeRange};
 
 use script::{Prompt, Script};
 
@@ -73,6 +73,9 @@ pub struct Sitting {
     script: Script,
     plan: Vec<Prompt>,
     accepted: Vec<bool>,
+    /// The `start`/`end` of each accepted take, as a resumed manifest gave them (an edit the
+    /// operator made by hand survives the manifest being written again; a new take is whole).
+    ranges: Vec<TakeRange>,
     /// Accepted takes to record again: they stay in the manifest until their new take passes.
     redo: Vec<bool>,
     /// The takes the last finish said to redo, until `/session/redo` or another control.
@@ -90,6 +93,7 @@ impl Sitting {
         let plan = script.plan();
         Sitting {
             accepted: vec![false; plan.len()],
+            ranges: vec![TakeRange::WHOLE; plan.len()],
             redo: vec![false; plan.len()],
             offered: Vec::new(),
             script,
@@ -108,7 +112,9 @@ impl Sitting {
         let mut s = Sitting::new(script, ext);
         for (i, p) in s.plan.iter().enumerate() {
             let file = p.file_name(&s.ext);
-            s.accepted[i] = manifest.takes.iter().any(|t| t.file == file);
+            let listed = manifest.takes.iter().find(|t| t.file == file);
+            s.accepted[i] = listed.is_some();
+            s.ranges[i] = listed.map_or(TakeRange::WHOLE, SessionTake::range);
         }
         s.rate_hz = Some(manifest.rate_hz);
         s.last_accepted = (0..s.plan.len()).rev().find(|&i| s.accepted[i]);
@@ -299,6 +305,7 @@ impl Sitting {
         match outcome {
             Ok(rate_hz) => {
                 self.accepted[self.cursor] = true;
+                self.ranges[self.cursor] = TakeRange::WHOLE;
                 self.redo[self.cursor] = false;
                 self.last_accepted = Some(self.cursor);
                 self.rate_hz.get_or_insert(rate_hz);
@@ -328,9 +335,12 @@ impl Sitting {
             .plan
             .iter()
             .zip(&self.accepted)
-            .filter(|(_, &a)| a)
-            .map(|(p, _)| {
-                SessionTake::whole(p.file_name(&self.ext), p.sentence_id(), p.emotion.clone())
+            .zip(&self.ranges)
+            .filter(|((_, &a), _)| a)
+            .map(|((p, _), range)| SessionTake {
+                start: range.start,
+                end: range.end,
+                ..SessionTake::whole(p.file_name(&self.ext), p.sentence_id(), p.emotion.clone())
             })
             .collect();
         (!takes.is_empty()).then(|| Session {

@@ -127,3 +127,26 @@ fn a_finish_offers_its_redo_which_prompts_just_those_takes_or_a_second_finish_cl
         "another control declined the offer"
     );
 }
+
+#[test]
+fn issue_37_a_resumed_session_keeps_the_ranges_written_into_its_manifest() {
+    let mut s = sitting();
+    assert_eq!(s.handle(C::Skip), Ok(Step::Moved));
+    for _ in 1..3 {
+        s.handle(C::Start).expect("start");
+        s.handle(C::Stop).expect("stop");
+        s.handle_checked(Ok(100.0));
+    }
+    let mut manifest = s.manifest().expect("takes");
+    manifest.takes[1].start = Some(replay::session::FrameOrTime::Frame(40));
+    manifest.takes[1].end = Some(replay::session::FrameOrTime::Seconds(2.5));
+    let mut resumed = Sitting::resume(Script::harvard(2), "c3d", &manifest);
+    assert_eq!(resumed.manifest().expect("takes"), manifest);
+    resumed.handle(C::Start).expect("start");
+    resumed.handle(C::Stop).expect("stop");
+    resumed.handle_checked(Ok(100.0));
+    let written = resumed.manifest().expect("takes");
+    assert_eq!(written.takes.len(), 3);
+    assert_eq!(written.takes[2], manifest.takes[1], "kept as edited");
+    assert!(written.takes[0].range().is_whole(), "a new take is whole");
+}
