@@ -149,7 +149,8 @@ pub struct ConvertArgs {
 #[derive(Debug, Args)]
 pub struct TrainArgs {
     /// Session manifest listing the takes (session.toml: `rate_hz`, required, then
-    /// `[[take]]` tables with file, sentence, emotion).
+    /// `[[take]]` tables with file, sentence, emotion, and optional start/end: the frames used,
+    /// as `convert --start/--end` writes them).
     #[arg(long)]
     pub manifest: Option<PathBuf>,
     /// Take files (in addition to the manifest's).
