@@ -90,10 +90,9 @@ impl Stream {
         }
     }
 
-    /// Without a model: the gathered frame (the source's markers, in its order) as the
-    /// output, missing markers missing. `false` when the frame refused it (an internal
-    /// invariant).
-    fn pass_frame(&mut self, header: &FrameHeader, output: Option<&mut FrameBuf>) -> bool {
+    /// The gathered frame into `self.out` as received: seen markers as they are, missing ones
+    /// as NaN.
+    fn copy_as_received(&mut self) {
         for ((out, xyz), &gone) in self
             .out
             .chunks_exact_mut(3)
@@ -106,6 +105,13 @@ impl Stream {
                 out.copy_from_slice(xyz);
             }
         }
+    }
+
+    /// Without a model: the gathered frame (the source's markers, in its order) as the
+    /// output, missing markers missing. `false` when the frame refused it (an internal
+    /// invariant).
+    fn pass_frame(&mut self, header: &FrameHeader, output: Option<&mut FrameBuf>) -> bool {
+        self.copy_as_received();
         output.is_none_or(|output| {
             output
                 .set_frame(header.frame_number, header.capture_time_us, &self.out)
@@ -130,18 +136,7 @@ impl Stream {
         if held {
             // Too few markers to estimate the face: what was seen goes out as received, the
             // rest as missing, rather than the last estimate passed off as data.
-            for ((out, xyz), &gone) in self
-                .out
-                .chunks_exact_mut(3)
-                .zip(self.xyz.chunks_exact(3))
-                .zip(&self.missing)
-            {
-                if gone {
-                    out.fill(f32::NAN);
-                } else {
-                    out.copy_from_slice(xyz);
-                }
-            }
+            self.copy_as_received();
         }
         resynthesised.is_ok()
             && output

@@ -138,7 +138,13 @@ async fn file(State(m): State<Arc<Monitor>>, headers: HeaderMap, uri: Uri) -> Re
     if let Some(r) = gate((&m.access, &m.hub.refused), &headers, &uri, false) {
         return r;
     }
-    match FILES.iter().find(|(path, _, _)| *path == uri.path()) {
+    page_file(FILES, &uri)
+}
+
+/// The file of `files` (path, content type, text) that `uri` names, or 404, with the page's
+/// security headers: the monitor's and the session view's files are served the same way.
+pub(crate) fn page_file(files: &[(&str, &'static str, &'static str)], uri: &Uri) -> Response {
+    match files.iter().find(|(path, _, _)| *path == uri.path()) {
         Some((_, kind, text)) => secure(
             ([(header::CONTENT_TYPE, *kind)], *text).into_response(),
             PAGE_POLICY,

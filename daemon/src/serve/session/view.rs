@@ -31,7 +31,9 @@ use super::Request;
 use crate::offline::session::{Sitting, State as Phase};
 use crate::serve::guard::Guard;
 use crate::serve::monitor::access::Access;
-use crate::serve::monitor::http::{gate, header_str, secure, CSS, HTML, JS, PAGE_POLICY};
+use crate::serve::monitor::http::{
+    gate, header_str, page_file, secure, CSS, HTML, JS, PAGE_POLICY,
+};
 
 /// The performer view's default address.
 pub const DEFAULT_VIEW: &str = "127.0.0.1:9080";
@@ -170,13 +172,7 @@ async fn file(State(page): State<Arc<Page>>, headers: HeaderMap, uri: Uri) -> Re
     if let Some(r) = gate((&page.access, &page.refused), &headers, &uri, false) {
         return r;
     }
-    match FILES.iter().find(|(path, _, _)| *path == uri.path()) {
-        Some((_, kind, text)) => secure(
-            ([(header::CONTENT_TYPE, *kind)], *text).into_response(),
-            PAGE_POLICY,
-        ),
-        None => secure(StatusCode::NOT_FOUND.into_response(), PAGE_POLICY),
-    }
+    page_file(FILES, &uri)
 }
 
 /// The view's fields, and what this page may do (`control`: allowed, why not, whether the
