@@ -215,6 +215,17 @@ fn labels(params: &Params, points: usize) -> Vec<String> {
         }
         k += 1;
     }
+    unique_labels(&raw, points)
+}
+
+/// `points` labels from `raw`: a missing or empty one is `M` and its 1-based number, and a
+/// repeated one gets the first free `_2`, `_3`, ... suffix.
+fn unique_labels(raw: &[String], points: usize) -> Vec<String> {
+    // Hashed, both the labels taken and each base's next suffix: a damaged file may repeat one
+    // label over 65,535 points, and a linear search per suffix made that cubic (seconds per
+    // file; found by fuzzing).
+    let mut taken = std::collections::HashSet::with_capacity(points);
+    let mut next_suffix = std::collections::HashMap::<String, usize>::new();
     let mut out: Vec<String> = Vec::with_capacity(points);
     for i in 0..points {
         let base = match raw.get(i) {
@@ -222,12 +233,19 @@ fn labels(params: &Params, points: usize) -> Vec<String> {
             _ => format!("M{:03}", i + 1),
         };
         let mut label = base.clone();
-        let mut n = 2;
-        while out.contains(&label) {
-            label = format!("{base}_{n}");
-            n += 1;
+        if taken.contains(&label) {
+            // Every suffix below the one kept for this base was taken, and stays taken.
+            let n = next_suffix.entry(base.clone()).or_insert(2);
+            while taken.contains(&label) {
+                label = format!("{base}_{n}");
+                *n += 1;
+            }
         }
+        taken.insert(label.clone());
         out.push(label);
     }
     out
 }
+
+#[cfg(test)]
+mod tests;
