@@ -134,6 +134,13 @@ pub(crate) fn run(args: &ServeArgs) -> Result<()> {
 
 /// Cancels `token` on Ctrl-C or SIGTERM.
 pub(crate) async fn cancel_on_signal(token: CancellationToken) {
+    signalled().await;
+    tracing::info!(target: "emoshift", "shutting down");
+    token.cancel();
+}
+
+/// Returns on Ctrl-C or SIGTERM.
+pub(crate) async fn signalled() {
     #[cfg(unix)]
     {
         use tokio::signal::unix::{signal, SignalKind};
@@ -151,6 +158,4 @@ pub(crate) async fn cancel_on_signal(token: CancellationToken) {
     }
     #[cfg(not(unix))]
     let _ = tokio::signal::ctrl_c().await;
-    tracing::info!(target: "emoshift", "shutting down");
-    token.cancel();
 }

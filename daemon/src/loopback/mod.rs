@@ -1,7 +1,8 @@
 //! One loopback harness for the demo, `emoshift bench` and the end-to-end tests: the daemon
 //! in this process ([`Daemon`]), paced sources ([`source`]), receivers ([`Receiver`]), a
 //! control client ([`ControlClient`]), a NatNet server standing in for Motive ([`motive`]),
-//! what a client sees of the emotion edit ([`probe`]), and synthetic models and frames
+//! what a client sees of the emotion edit ([`probe`]), a take replayed while a control script
+//! runs and a subscribed client collects ([`scripted`]), and synthetic models and frames
 //! ([`synthetic`]).
 //! Everything binds 127.0.0.1 only. `emoshift replay` sends through the same [`Source`] and
 //! [`source::drive`], so a replay and a test source send alike.
@@ -11,12 +12,14 @@ pub mod daemon;
 pub mod motive;
 pub mod probe;
 pub mod receiver;
+pub mod scripted;
 pub mod source;
 
 pub use control::{counter, text, ControlClient};
 pub use daemon::Daemon;
 pub use engine::synthetic;
 pub use receiver::{Collecting, Received, Receiver};
+pub use scripted::{Cue, Subscribed};
 pub use source::Source;
 
 /// Runs `work` on a current-thread runtime of its own: the client side of a harness run (the
