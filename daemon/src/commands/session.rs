@@ -204,14 +204,8 @@ fn finish(args: &Finishing) -> Result<Advice> {
     }
     let regions_path = dir.join("regions.toml");
     let regions = regions_path.exists().then_some(&regions_path);
-    let mut options = match regions {
-        Some(path) => super::train::options_with_regions(Regions::load(path)?),
-        None => crate::offline::training::TrainOptions::default(),
-    };
-    options.prep.rate_hz = Some(session.rate_hz);
     crate::out!("training on {} takes ...", session.takes.len());
-    let takes = crate::offline::load_inputs(Some(&manifest), &[])?;
-    super::train::train_and_save(&takes, &options, &model_path)?;
+    super::train::train_session(&manifest, regions.map(PathBuf::as_path), &model_path)?;
     if regions.is_none() {
         crate::out!(
             "no regions.toml in {}: the model is trained but not analysed (roles, emotion \

@@ -148,6 +148,26 @@ pub(crate) fn run(args: &TrainArgs) -> Result<()> {
     save_and_print(trained, takes.len(), &args.out, started).map(drop)
 }
 
+/// Trains on the takes of the session at `manifest`, at its rate, with the default options and
+/// `regions` (the head reference it may name), writes the model to `out` and prints what
+/// training found, as `train --manifest` does; returns the model.
+///
+/// # Errors
+/// An unreadable manifest, regions file or take, or training failed.
+pub(crate) fn train_session(
+    manifest: &Path,
+    regions: Option<&Path>,
+    out: &Path,
+) -> Result<IcaModel> {
+    let mut options = match regions {
+        Some(path) => options_with_regions(Regions::load(path)?),
+        None => TrainOptions::default(),
+    };
+    options.prep.rate_hz = Some(offline::load_session(manifest)?.rate_hz);
+    let takes = offline::load_inputs(Some(manifest), &[])?;
+    train_and_save(&takes, &options, out)
+}
+
 /// Trains on `takes` held in memory, writes the model to `out` and prints what training
 /// found, as `train` does; returns the model.
 pub(crate) fn train_and_save(
