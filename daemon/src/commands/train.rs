@@ -117,7 +117,7 @@ pub(crate) fn options(args: &TrainArgs) -> Result<TrainOptions> {
 }
 
 /// The default options with a regions file (which may name the head reference).
-pub(crate) fn options_with_regions(regions: Regions) -> TrainOptions {
+fn options_with_regions(regions: Regions) -> TrainOptions {
     let mut options = TrainOptions::default();
     let patterns = offline::training::DEFAULT_HEAD_PATTERNS.map(String::from);
     options.prep.head = head_choice(None, &patterns, Some(&regions));
@@ -170,11 +170,7 @@ pub(crate) fn train_session(
 
 /// Trains on `takes` held in memory, writes the model to `out` and prints what training
 /// found, as `train` does; returns the model.
-pub(crate) fn train_and_save(
-    takes: &[LoadedTake],
-    options: &TrainOptions,
-    out: &Path,
-) -> Result<IcaModel> {
+fn train_and_save(takes: &[LoadedTake], options: &TrainOptions, out: &Path) -> Result<IcaModel> {
     let started = Instant::now();
     let bar = ProgressBar::new_spinner();
     let trained = training::train(takes, options, &mut |stage| match stage {
