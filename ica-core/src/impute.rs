@@ -132,8 +132,10 @@ pub fn fill_gaps(
 #[derive(Debug, Clone)]
 pub struct GapModel {
     mean: Vec<f64>,
-    /// `A = E Λ^½`, channels x m.
-    loadings: DMatrix<f64>,
+    /// `A = E Λ^½`, channels x m, row by row: a frame's fill reads a channel's row at a time.
+    loadings: Vec<f64>,
+    /// Kept axes (m).
+    axes: usize,
     /// Variance per live channel the kept axes leave out.
     residual: f64,
 }
@@ -169,41 +171,53 @@ impl GapModel {
         channels: usize,
     ) -> GapModel {
         let m = basis.ncols();
-        let mut loadings = DMatrix::zeros(channels, m);
+        let mut loadings = vec![0.0; channels * m];
         for (r, &c) in live.iter().enumerate() {
             for k in 0..m {
-                loadings[(c, k)] = basis[(r, k)] * eigenvalues[k].sqrt();
+                loadings[c * m + k] = basis[(r, k)] * eigenvalues[k].sqrt();
             }
         }
         let left: f64 = eigenvalues.iter().skip(m).sum();
         GapModel {
             mean: mean.to_vec(),
             loadings,
+            axes: m,
             residual: left / live.len().max(1) as f64,
         }
     }
 
     /// Fills the `missing` channels of `frame` with their posterior mean given the others.
     pub fn fill(&self, frame: &mut [f32], missing: &[bool]) {
-        let m = self.loadings.ncols();
-        let mut gram = DMatrix::<f64>::identity(m, m) * self.residual.max(1e-12);
+        let m = self.axes;
+        // `σ² I + Σ a_c a_cᵀ` and `Σ a_c (x_c − mean_c)` over the visible channels, summed in
+        // place channel after channel (the upper triangle, mirrored): the same sums as outer
+        // products added one by one, without a matrix product and two temporaries per channel.
+        let mut gram = DMatrix::<f64>::zeros(m, m);
+        gram.fill_diagonal(self.residual.max(1e-12));
         let mut rhs = DVector::<f64>::zeros(m);
         for (c, &gone) in missing.iter().enumerate() {
             if gone {
                 continue;
             }
-            let row = self.loadings.row(c);
+            let row = &self.loadings[c * m..(c + 1) * m];
             let centred = f64::from(frame[c]) - self.mean[c];
-            gram += row.transpose() * row;
-            rhs += row.transpose() * centred;
+            for (j, &aj) in row.iter().enumerate() {
+                for (i, &ai) in row[..=j].iter().enumerate() {
+                    gram[(i, j)] += ai * aj;
+                }
+                rhs[j] += aj * centred;
+            }
         }
+        gram.fill_lower_triangle_with_upper_triangle();
         let Some(chol) = gram.cholesky() else {
             return;
         };
         let v = chol.solve(&rhs);
         for (c, &gone) in missing.iter().enumerate() {
             if gone {
-                frame[c] = (self.mean[c] + self.loadings.row(c).dot(&v.transpose())) as f32;
+                let row = &self.loadings[c * m..(c + 1) * m];
+                let fitted = row.iter().zip(v.iter()).fold(0.0, |s, (a, b)| s + a * b);
+                frame[c] = (self.mean[c] + fitted) as f32;
             }
         }
     }
