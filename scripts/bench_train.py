@@ -81,20 +81,21 @@ def report(m, path):
                 if w[1] not in train:
                     order.append(w[1])
                 train.setdefault(w[1], []).append(
-                    (float(w[2]), int(w[3]), int(w[4]), float(w[5])))
+                    (float(w[2]), int(w[3]), int(w[4]), float(w[5]), float(w[6])))
             elif w[0] == "sklearn":
                 sk[w[1]] = (float(w[2]), int(w[3]), int(w[4]), int(w[5]), w[6] == "1")
             elif w[0] in ("edit", "project"):
                 stream.setdefault(w[0], []).append((float(w[1]), int(w[2]), int(w[3])))
     print(f"\n| layout | frames | channels | `train --components {m}`: median s (min-max) "
-          "| head + glitch limits: median s (share) | peak RSS MB | scikit-learn: best s "
-          "(iterations) | ratio |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+          "| head decision: median s (share) | glitch limits: median s | peak RSS MB "
+          "| scikit-learn: best s (iterations) | ratio |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for layout in order:
         runs = train[layout]
         wall = statistics.median(r[0] for r in runs)
         head = statistics.median(r[3] for r in runs)
         share = statistics.median(r[3] / r[0] for r in runs)
+        limits = statistics.median(r[4] for r in runs)
         rss = statistics.median(r[1] for r in runs) / 1024
         lo, hi = min(r[0] for r in runs), max(r[0] for r in runs)
         frames = runs[0][2]
@@ -107,7 +108,7 @@ def report(m, path):
         else:
             ch, skcell, ratio = "-", "-", "-"
         print(f"| {layout} | {frames:,} | {ch} | {wall:.3f} ({lo:.3f}-{hi:.3f}) | "
-              f"{head:.3f} ({100 * share:.0f} %) | {rss:.0f} | {skcell} | {ratio} |")
+              f"{head:.3f} ({100 * share:.0f} %) | {limits:.3f} | {rss:.0f} | {skcell} | {ratio} |")
     if stream:
         print("\n| command (10-minute take) | median s (min-max) | MB/s of C3D read | peak RSS MB |")
         print("|---|---:|---:|---:|")

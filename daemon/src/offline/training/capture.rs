@@ -24,7 +24,8 @@ pub(super) struct Learned {
     pub head: HeadReport,
 }
 
-/// Learns the capture settings from `frames` (stretches of takes, in model marker order).
+/// Learns the capture settings from `frames` (stretches of takes, in model marker order):
+/// [`decide_head`], then [`learn_limits`].
 ///
 /// # Errors
 /// Named reference markers that do not resolve, too few of them, or a template that cannot be
@@ -36,10 +37,31 @@ pub(super) fn learn(
     rate_hz: f64,
     options: &PrepOptions,
 ) -> Result<Learned> {
+    let decided = decide_head(frames, labels, excluded, options)?;
+    learn_limits(frames, labels.len(), rate_hz, options, decided)
+}
+
+/// The head decision, and the head reference it makes (none without stabilisation).
+#[derive(Debug, Clone)]
+pub(super) struct DecidedHead {
+    head: Option<HeadReference>,
+    reference: Vec<usize>,
+    report: HeadReport,
+}
+
+/// Decides the head on the raw `frames`; its template is the decision's own Procrustes mean
+/// over the sample it assessed the reference on (it shrugs off rare glitches, and the sample's
+/// glitches are masked).
+///
+/// # Errors
+/// As [`learn`].
+pub(super) fn decide_head(
+    frames: &[ModelFrames],
+    labels: &[String],
+    excluded: &[(String, f64)],
+    options: &PrepOptions,
+) -> Result<DecidedHead> {
     let n = labels.len();
-    // 1. The head: decided on the raw frames, its template the decision's own Procrustes mean
-    //    over the sample it assessed the reference on (it shrugs off rare glitches, and the
-    //    sample's glitches are masked).
     let (raw_xyz, raw_missing, ranges) = concatenated(frames, n);
     let raw = MarkerFrames {
         xyz: &raw_xyz,
@@ -48,7 +70,6 @@ pub(super) fn learn(
         takes: &ranges,
     };
     let decision = head::decide(&options.head, labels, excluded, &raw)?;
-    drop((raw_xyz, raw_missing));
     let reference = decision.markers;
     let head = match reference.len() {
         0 => None,
@@ -61,12 +82,30 @@ pub(super) fn learn(
             .clone(),
         ),
     };
-    let mut capture = CaptureSettings {
+    Ok(DecidedHead {
         head,
+        reference,
+        report: decision.report,
+    })
+}
+
+/// The glitch limits (speeds and plausible regions) measured on `frames` (`n` markers) in the
+/// coordinates of the `decided` head.
+///
+/// # Errors
+/// Preparing the frames failing.
+pub(super) fn learn_limits(
+    frames: &[ModelFrames],
+    n: usize,
+    rate_hz: f64,
+    options: &PrepOptions,
+    decided: DecidedHead,
+) -> Result<Learned> {
+    let mut capture = CaptureSettings {
+        head: decided.head,
         max_speed_mm_s: None,
         bounds: None,
     };
-    // 2. Speeds and plausible regions measured in head coordinates.
     let (head_xyz, head_missing, _, _) = run_prep(frames, n, rate_hz, &capture)?;
     // The two are independent: at once on the current rayon pool.
     let (speed, bounds) = rayon::join(
@@ -85,8 +124,8 @@ pub(super) fn learn(
     capture.bounds = bounds;
     Ok(Learned {
         capture,
-        reference,
-        head: decision.report,
+        reference: decided.reference,
+        head: decided.report,
     })
 }
 

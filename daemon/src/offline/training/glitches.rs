@@ -24,7 +24,12 @@ pub(super) fn marker_bounds(xyz: &[f32], missing: &[bool], n: usize) -> MarkerBo
     use rayon::prelude::*;
     // Each marker's present positions, axis by axis, gathered in one pass over the frames:
     // read marker by marker, the frame-major layout would miss the cache at every sample.
-    let mut axes: Vec<[Vec<f32>; 3]> = (0..n).map(|_| Default::default()).collect();
+    // Sized for every frame at once: grown push by push, they were copied and faulted in again
+    // at every doubling.
+    let frames = xyz.len() / (3 * n.max(1));
+    let mut axes: Vec<[Vec<f32>; 3]> = (0..n)
+        .map(|_| std::array::from_fn(|_| Vec::with_capacity(frames)))
+        .collect();
     for (frame, gone) in xyz
         .chunks_exact(3 * n.max(1))
         .zip(missing.chunks_exact(n.max(1)))

@@ -136,8 +136,14 @@ fn streamed(
     pool: &ThreadPool,
     progress: &mut dyn Progress,
 ) -> Result<Trained> {
-    progress.step("learning the head and glitch limits", "frames", None);
-    let learned = pool.install(|| learn(&scanned, options))?;
+    progress.step("deciding the head", "frames", None);
+    let (sample, labels) = (&scanned.sample, &scanned.labels);
+    let decided =
+        pool.install(|| capture::decide_head(sample, labels, &scanned.excluded, &options.prep))?;
+    progress.step("learning the glitch limits", "frames", None);
+    let (n, rate_hz) = (labels.len(), scanned.rate_hz);
+    let learned =
+        pool.install(|| capture::learn_limits(sample, n, rate_hz, &options.prep, decided))?;
     let total = scanned.total_frames();
     let (scanned, raw) = scanned.take_raw()?;
     let (mut collected, head_residuals) = statistics(&scanned, raw, &learned, pool, progress)?;
@@ -184,17 +190,6 @@ fn streamed(
         noise_mm,
         capped_at_noise,
     })
-}
-
-/// The head reference and glitch limits, learned from the scan's sample.
-fn learn(scanned: &scan::Scan, options: &TrainOptions) -> Result<capture::Learned> {
-    capture::learn(
-        &scanned.sample,
-        &scanned.labels,
-        &scanned.excluded,
-        scanned.rate_hz,
-        &options.prep,
-    )
 }
 
 /// Each marker's RMS residual over the residual frames (`channels` values each), and the slow
