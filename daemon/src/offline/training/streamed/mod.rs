@@ -136,14 +136,7 @@ fn streamed(
     pool: &ThreadPool,
     progress: &mut dyn Progress,
 ) -> Result<Trained> {
-    progress.step("deciding the head", "frames", None);
-    let (sample, labels) = (&scanned.sample, &scanned.labels);
-    let decided =
-        pool.install(|| capture::decide_head(sample, labels, &scanned.excluded, &options.prep))?;
-    progress.step("learning the glitch limits", "frames", None);
-    let (n, rate_hz) = (labels.len(), scanned.rate_hz);
-    let learned =
-        pool.install(|| capture::learn_limits(sample, n, rate_hz, &options.prep, decided))?;
+    let learned = learn(&scanned, options, pool, progress)?;
     let total = scanned.total_frames();
     let (scanned, raw) = scanned.take_raw()?;
     let (mut collected, head_residuals) = statistics(&scanned, raw, &learned, pool, progress)?;
@@ -190,6 +183,22 @@ fn streamed(
         noise_mm,
         capped_at_noise,
     })
+}
+
+/// The head reference, then the glitch limits, learned from the scan's sample: two steps, so
+/// the head decision's time is reported apart.
+fn learn(
+    scanned: &scan::Scan,
+    options: &TrainOptions,
+    pool: &ThreadPool,
+    progress: &mut dyn Progress,
+) -> Result<capture::Learned> {
+    let (sample, labels, prep) = (&scanned.sample, &scanned.labels, &options.prep);
+    progress.step("deciding the head", "frames", None);
+    let decided = pool.install(|| capture::decide_head(sample, labels, &scanned.excluded, prep))?;
+    progress.step("learning the glitch limits", "frames", None);
+    let (n, rate_hz) = (labels.len(), scanned.rate_hz);
+    pool.install(|| capture::learn_limits(sample, n, rate_hz, prep, decided))
 }
 
 /// Each marker's RMS residual over the residual frames (`channels` values each), and the slow
