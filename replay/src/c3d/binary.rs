@@ -93,6 +93,8 @@ pub struct Header {
     pub points: u16,
     /// Analog samples per 3D frame, all channels together.
     pub analog_per_frame: u16,
+    /// Analog samples per channel per 3D frame (word 10).
+    pub analog_per_channel: u16,
     /// First frame number.
     pub first_frame: u16,
     /// Last frame number (65535 when the real value does not fit; see TRIAL:ACTUAL_END_FIELD).
@@ -136,6 +138,7 @@ pub fn parse_header(bytes: &[u8]) -> Result<(Processor, Header), C3dError> {
         parameter_block,
         points: w(2),
         analog_per_frame: w(4),
+        analog_per_channel: w(18),
         first_frame: w(6),
         last_frame: w(8),
         scale: f(12),

@@ -148,6 +148,16 @@ pub fn via_c3dio(
             h.first_frame, h.last_frame
         ));
     }
+    // Likewise its analog grid, frames x ANALOG:USED x samples per channel: parameters that
+    // claim more analog samples than a frame's record holds (gigabytes from a 12 KB file,
+    // found by fuzzing) never reach it.
+    if l.analog_claimed > l.analog_per_frame.max(1) {
+        return Err(format!(
+            "the parameters claim {} analog samples a frame where the records hold {}, too many \
+             for c3dio",
+            l.analog_claimed, l.analog_per_frame
+        ));
+    }
     let canonical = canonical_layout(bytes, l, h, sample)?;
     CATCHING.with(|c| c.set(true));
     let parsed = catch_unwind(AssertUnwindSafe(|| {
@@ -221,6 +231,7 @@ fn canonical_layout(
     if data_end > bytes.len() {
         return Err("data outside the file".into());
     }
+    c3dio_walk_ends(params, l.processor)?;
     let blocks = params.len().div_ceil(BLOCK);
     let data_block = u16::try_from(2 + blocks).map_err(|_| "too many parameter blocks")?;
     let mut out = Vec::with_capacity(BLOCK * (1 + blocks) + sample.len() * record);
@@ -244,3 +255,33 @@ fn canonical_layout(
     out.resize(out.len().next_multiple_of(BLOCK), 0);
     Ok(out)
 }
+
+/// Whether c3dio 0.8's walk over the parameter records `params` (the section from its first
+/// byte) reaches an end. It steps from record to record by the name's length and the "next"
+/// offset after it, taking the length byte as `i8` and its absolute value: a length byte of
+/// 0x80 (-128) overflows and sends the walk backwards, into a loop that allocates without bound
+/// (found by fuzzing: gigabytes from a 12 KB file). Every other record moves it forward, so a
+/// section without that byte on the walk's path ends, as here.
+pub(crate) fn c3dio_walk_ends(params: &[u8], processor: Processor) -> Result<(), String> {
+    let mut at = 4;
+    // c3dio stops at a group id of zero, or at the section's end.
+    while at + 1 < params.len() && params[at + 1] != 0 {
+        let name_len = i8::from_ne_bytes([params[at]]);
+        if name_len == i8::MIN {
+            return Err(format!(
+                "a parameter name length of -128 at byte {at} of the parameters, which c3dio \
+                 cannot step past"
+            ));
+        }
+        let offset_at = at + 2 + usize::from(name_len.unsigned_abs());
+        // Past the end, c3dio's own slice fails (an error or a caught panic): it ends there.
+        let Some(offset) = take2(params, offset_at) else {
+            return Ok(());
+        };
+        at = offset_at + usize::from(processor.u16(offset));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;

@@ -16,6 +16,10 @@ pub struct Layout {
     pub points: usize,
     /// Analog samples per frame (all channels), interleaved after the points.
     pub analog_per_frame: usize,
+    /// Analog samples per frame as the parameters claim them: the header's samples per channel
+    /// times ANALOG:USED (`analog_per_frame` in a consistent file). c3dio sizes its analog grid
+    /// by it; emoshift reads nothing else from it.
+    pub analog_claimed: usize,
     /// Float32 storage (header scale negative) rather than scaled int16.
     pub float: bool,
     /// Magnitude of the point scale: int16 values are multiplied by it.
@@ -70,6 +74,7 @@ impl Layout {
             processor: p,
             points,
             analog_per_frame: usize::from(h.analog_per_frame),
+            analog_claimed: analog_claimed(h, params),
             float,
             scale,
             first_frame,
@@ -95,6 +100,15 @@ impl Layout {
         layout.labels.truncate(points);
         Ok(layout)
     }
+}
+
+/// The header's analog samples per channel times ANALOG:USED (read unsigned, as the largest a
+/// reader could take it for); none without the parameter.
+fn analog_claimed(h: &Header, params: &Params) -> usize {
+    let used = params.number("ANALOG", "USED", true).unwrap_or(0.0);
+    // A float parameter may hold anything: c3dio converts it to u16.
+    let used = used.clamp(0.0, f64::from(u16::MAX)) as usize;
+    usize::from(h.analog_per_channel) * used
 }
 
 fn point_count(h: &Header, params: &Params) -> Result<usize, C3dError> {

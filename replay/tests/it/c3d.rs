@@ -299,3 +299,20 @@ fn metres_and_centimetres_are_converted_to_millimetres() {
         "unknown units \"ft\" (expected mm, cm or m)"
     );
 }
+
+/// Files the fuzzer found that made c3dio allocate without bound (see fixtures/SOURCE.md): the
+/// reader returns, and where it reads the take it did so with our own decoder alone and says
+/// why c3dio was not asked. Without the guards, c3dio allocates 3.8 GB for the first and loops
+/// growing a vector until memory runs out on the second.
+#[test]
+fn files_that_make_c3dio_allocate_without_bound_never_reach_it() {
+    let bytes = std::fs::read(fixture("fuzz/c3dio-analog-grid.c3d")).expect("fixture");
+    let (_, info) = c3d::read_with_info(&bytes).expect("our decoder reads it");
+    assert_eq!(info.decoder, Decoder::Fallback);
+    let error = info.c3dio_error.unwrap_or_default();
+    assert!(error.contains("analog samples"), "{error}");
+    // This one is refused after the cross-check, for its values.
+    let bytes = std::fs::read(fixture("fuzz/c3dio-walks-back.c3d")).expect("fixture");
+    let err = c3d::read_with_info(&bytes).expect_err("its values are not positions");
+    assert!(err.to_string().contains("not a position"), "{err}");
+}
