@@ -26,7 +26,7 @@ fn a_well_formed_section_is_walked_to_its_end() {
 #[test]
 fn a_name_length_of_minus_128_on_the_walk_is_refused_before_c3dio_loops() {
     let s = section(&[(5, -1), (0x80, 1)]);
-    let err = c3dio_walk_ends(&s, Processor::Intel).unwrap_err();
+    let err = c3dio_walk_ends(&s, Processor::Intel).expect_err("refused");
     assert!(err.contains("-128"), "{err}");
     // The same byte where no record starts is not on the walk.
     let mut s = section(&[(5, -1), (6, 1)]);
