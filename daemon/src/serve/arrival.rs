@@ -1,10 +1,9 @@
 //! When the processing thread should poll for the next frame instead of parking, sans-IO.
 //!
 //! Waking a parked thread costs 30-50 µs on a virtual machine (the idle CPU must be
-//! interrupted and rescheduled), more than the whole frame path: with a receive task and a
-//! processing thread, a frame pays that twice where a relay pays it once. But a stage sends
-//! on a steady clock (cameras are genlocked), so the next frame's arrival is predictable. The
-//! thread parks until [`SpinWindow::lead`] before it and then polls the queue until it comes,
+//! interrupted and rescheduled), more than the whole frame path. But a stage sends on a steady
+//! clock (cameras are genlocked), so the next frame's arrival is predictable. The thread
+//! parks until [`SpinWindow::lead`] before it and then polls its socket and queue until it comes,
 //! or until [`SpinWindow::grace`] after it; anything off the beat is received the ordinary
 //! way. The window is skipped when it would take more than [`MAX_DUTY`] of the period, so
 //! unsteady or interleaved sources cost no CPU.

@@ -25,6 +25,7 @@ use tokio_util::task::TaskTracker;
 use super::command::{Command, Refusal, Reply, Request};
 pub(crate) use super::guard::Guard;
 use super::stats::Stats;
+use super::wake::Doorbell;
 
 /// How long a control message waits for the processing thread's answer.
 const ANSWER_TIMEOUT: Duration = Duration::from_secs(2);
@@ -34,6 +35,8 @@ const ANSWER_TIMEOUT: Duration = Duration::from_secs(2);
 pub(crate) struct ControlCtx {
     pub(crate) socket: Arc<UdpSocket>,
     pub(crate) cmd_tx: Sender<Request>,
+    /// Wakes the processing thread to take a command.
+    pub(crate) bell: Doorbell,
     pub(crate) stats: Arc<Mutex<Stats>>,
     /// The default model's file (SIGHUP reloads it); `None` before one is loaded.
     pub(crate) model_path: Arc<Mutex<Option<PathBuf>>>,
@@ -206,6 +209,7 @@ async fn ask(ctx: &ControlCtx, command: Command) -> Reply {
     ctx.cmd_tx
         .try_send(Request { command, reply })
         .map_err(|_| Refusal::Busy)?;
+    ctx.bell.ring();
     match tokio::time::timeout(ANSWER_TIMEOUT, rx).await {
         Ok(Ok(r)) => r,
         Ok(Err(_)) => Err(Refusal::ShuttingDown),

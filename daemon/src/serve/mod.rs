@@ -11,8 +11,9 @@
 //! - `control`: control datagrams → [`command`](self) requests to the processing thread, and
 //!   the replies;
 //! - [`queue`]: the sources' frames to the processing thread, pooled, latest frame wins;
-//! - `processing`: the processing thread: the sources' frames off the queue through the
-//!   engine to the sinks, commands between frames, counters merged into [`stats`];
+//! - `processing`: the processing thread: OSC frames off the frame socket it reads itself and
+//!   the other sources' frames off the queue, through the engine to the sinks, commands
+//!   between frames, counters merged into [`stats`]; [`wake`]: its doorbell;
 //! - [`arrival`]: when the processing thread polls instead of parking (a steady source's
 //!   beat);
 //! - [`monitor`]: the monitor page (HTTP + WebSocket, and its feed, a sink), when `monitor`
@@ -41,6 +42,7 @@ pub mod session;
 pub mod sinks;
 pub mod sources;
 pub mod stats;
+pub mod wake;
 
 pub use config::Config;
 pub use server::{bind, bind_with, Bound};

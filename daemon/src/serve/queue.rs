@@ -1,5 +1,6 @@
-//! The processing queue: every source's frames, copied into pooled buffers, on one bounded
-//! channel to the processing thread. When it is full the oldest frame is dropped and counted:
+//! The processing queue: the frames of every source but the OSC frame socket (which the
+//! processing thread reads itself), copied into pooled buffers, on one bounded channel to the
+//! processing thread, whose [`Doorbell`] each push rings. When it is full the oldest frame is dropped and counted:
 //! latest frame wins. Buffers go back to the pool once processed, so a warm queue allocates
 //! nothing (labels and names are shared, not copied).
 
@@ -11,6 +12,7 @@ use engine::{SourceFrame, StreamKey};
 use protocol::{FrameBuf, FrameTime};
 
 use crate::serve::sources::Arrival;
+use crate::serve::wake::Doorbell;
 
 /// One source frame, owned, on its way to the processing thread.
 #[derive(Debug)]
@@ -53,6 +55,8 @@ pub struct Queue {
     /// Frames dropped because the queue was full.
     dropped: Arc<AtomicU64>,
     max_markers: usize,
+    /// Wakes the processing thread.
+    bell: Doorbell,
 }
 
 /// The processing thread's ends.
@@ -68,8 +72,14 @@ pub struct QueueEnds {
 const POOL: usize = 256;
 
 impl Queue {
-    /// A queue of `len` frames of up to `max_markers` markers, counting drops in `dropped`.
-    pub fn new(len: usize, max_markers: usize, dropped: Arc<AtomicU64>) -> (Queue, QueueEnds) {
+    /// A queue of `len` frames of up to `max_markers` markers, counting drops in `dropped`,
+    /// ringing `bell` after each push.
+    pub fn new(
+        len: usize,
+        max_markers: usize,
+        dropped: Arc<AtomicU64>,
+        bell: Doorbell,
+    ) -> (Queue, QueueEnds) {
         let (tx, rx) = crossbeam_channel::bounded(len);
         let (free_tx, free) = crossbeam_channel::bounded(POOL);
         let queue = Queue {
@@ -78,6 +88,7 @@ impl Queue {
             free,
             dropped,
             max_markers,
+            bell,
         };
         let ends = QueueEnds {
             frames: rx,
@@ -111,7 +122,10 @@ impl Queue {
         };
         loop {
             match self.tx.try_send(item) {
-                Ok(()) => return true,
+                Ok(()) => {
+                    self.bell.ring();
+                    return true;
+                }
                 Err(TrySendError::Full(back)) => {
                     item = back;
                     if self.rx.try_recv().is_ok() {

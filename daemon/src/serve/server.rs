@@ -1,19 +1,20 @@
 //! Binds the sockets and runs the tasks (the only module that awaits, with `control`):
 //!
-//! - **sources**, one task each ([`super::sources`]): the OSC frame socket, the NatNet link
-//!   when configured; each frame into the processing [`Queue`] (bounded; when full the oldest
-//!   frame is dropped and counted: latest frame wins);
+//! - **sources** ([`super::sources`]): the OSC frame socket, read by the processing thread
+//!   itself; the NatNet and QTM links when configured, one task each, each frame into the
+//!   processing [`Queue`] (bounded; when full the oldest frame is dropped and counted: latest
+//!   frame wins);
 //! - **processing** (one blocking thread, [`Processing`]): [`Pipeline`] per frame, then every
 //!   sink ([`Outputs`]: the OSC subscribers first, the recording, the monitor feed); control
 //!   commands (edits, subscriptions, models, recordings) between frames;
 //! - **control**: decodes control messages and answers them;
 //! - **stats**: logs the counters every few seconds; **SIGHUP** reloads the model.
 //!
-//! Shutdown: the token stops the sources and control; the processing thread drains the queue,
-//! sends what it processes and closes the recording.
+//! Shutdown: the token stops the sources and control, and rings the processing thread, which
+//! stops reading the frame socket, drains the queue, sends what it processes and closes the
+//! recording.
 
 use std::net::SocketAddr;
-use std::sync::atomic::AtomicU64;
 use std::sync::{Arc, Mutex};
 
 use anyhow::{Context, Result};
@@ -25,28 +26,28 @@ use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
 use super::command::Request;
-use super::control::{self, ControlCtx, Guard};
+use super::control;
 use super::monitor::{Board, Feed};
-use super::processing::{Processing, Shared};
+use super::processing::{Inbox, Inputs, Processing, Shared};
 use super::queue::Queue;
 use super::sinks::natnet::{self as natnet_server, NatNetServer, NatNetSink};
 use super::sinks::qtm::{self as qtm_server, QtmServer, QtmSink};
 use super::sources::natnet::{Link, NatNetStatus};
-use super::sources::osc::OscSource;
 use super::sources::qtm::{self, QtmConfig, QtmStatus};
-use super::sources::{Answer, Arrival, InputCounters};
+use super::sources::{Arrival, InputCounters};
 use super::stats::{log_stats, model_name, status_into, Stats};
 use super::Config;
 
 mod assemble;
-use assemble::{outputs, processing_pipeline};
+use assemble::{control_ctx, osc_intake, outputs, processing_pipeline, ring_on_shutdown};
 
 type QtmInput = (QtmConfig, Arc<InputCounters>);
 
 /// A server with its sockets bound and its models loaded; [`Bound::run`] serves.
 #[derive(Debug)]
 pub struct Bound {
-    frames: UdpSocket,
+    /// The OSC frame socket (blocking mode is the processing thread's to set).
+    frames: std::net::UdpSocket,
     /// The frame socket again, for telling a source why its datagram was refused.
     replies: std::net::UdpSocket,
     control: UdpSocket,
@@ -93,8 +94,6 @@ async fn bind_model(config: Config, model: Option<Arc<IcaModel>>) -> Result<Boun
         .with_context(|| format!("binding the frame socket {}", config.listen))?;
     let replies = frames.try_clone().context("cloning the frame socket")?;
     replies.set_nonblocking(true)?;
-    frames.set_nonblocking(true)?;
-    let frames = UdpSocket::from_std(frames)?;
     let (control, control_news) = bind_control(config.control)?;
     let natnet = match config.natnet.clone() {
         Some(n) => {
@@ -219,55 +218,56 @@ impl Bound {
         let osc = Arc::new(InputCounters::named("osc"));
         let qtm = (self.config.qtm.clone()).map(|q| (q, Arc::new(InputCounters::named("qtm"))));
         let stats = new_stats(&self.config, &osc, (&self.natnet, &qtm));
-        let shared = Shared {
-            stats: Arc::clone(&stats),
-            queue_dropped: Arc::new(AtomicU64::new(0)),
-            not_allowed: Arc::new(AtomicU64::new(0)),
-        };
+        let shared = Shared::new(Arc::clone(&stats));
         let max_markers = PipelineConfig::default().max_markers;
+        let (inbox, bell) = Inbox::new(self.frames).context("waiting on the frame socket")?;
         let (queue, ends) = Queue::new(
             self.config.queue,
             max_markers,
             Arc::clone(&shared.queue_dropped),
+            bell.clone(),
         );
         let (cmd_tx, cmd_rx) = crossbeam_channel::bounded::<Request>(64);
-        let ctx = ControlCtx {
-            socket: Arc::new(self.control),
-            cmd_tx,
-            stats: Arc::clone(&stats),
-            model_path: Arc::new(Mutex::new(self.config.model.clone())),
-            model: Arc::new(Mutex::new(self.model.clone())),
-            tracker: tracker.clone(),
-            guard: Arc::new(Guard::new(&self.config)),
-        };
-        let every = self.config.stats_interval;
+        let commands = (cmd_tx, bell.clone());
+        let ctx = control_ctx(
+            self.control,
+            commands,
+            &stats,
+            (&self.config, &self.model),
+            &tracker,
+        );
         let board = Arc::new(Board::new());
         if let Some(listener) = self.monitor {
             let token = self.config.monitor_token.clone();
             let parts = (Arc::clone(&board), ctx.clone(), Arc::clone(&stats));
             super::monitor::spawn(listener, token, parts, &tracker, shutdown.clone())?;
         }
-        let source = OscSource {
-            socket: self.frames,
-            allow: self.config.frames_allow.clone(),
-            not_allowed: Arc::clone(&shared.not_allowed),
-            answer: Arc::new(Answer::new(Some(self.replies))),
-            counters: osc,
-            max_markers,
-        };
+        let osc = osc_intake(&self.config, &shared, self.replies, osc, max_markers);
         let feed = self.config.monitor.map(|_| Feed::new(board));
         let pipeline = processing_pipeline(self.model, self.performers, &self.config);
         let servers = (self.natnet_server, self.qtm_server);
         let sinks = spawn_servers(servers, &stats, &tracker, &shutdown);
         let outputs = outputs(&self.config, feed, sinks, self.control_news)?;
-        let window = self.config.poll_window;
-        let processing = Processing::new((pipeline, outputs), window, (ends, cmd_rx), shared);
+        let inputs = Inputs {
+            inbox,
+            osc,
+            queue: ends,
+            commands: cmd_rx,
+            shutdown: shutdown.clone(),
+        };
+        let (engine, window) = ((pipeline, outputs), self.config.poll_window);
+        let processing = Processing::new(engine, window, inputs, shared);
         let processing = tracker.spawn_blocking(move || processing.run());
+        ring_on_shutdown(bell, &tracker, &shutdown);
         let link = self.natnet.map(|n| n.0);
-        spawn_sources((source, link, qtm), (queue, &stats), &tracker, &shutdown);
+        spawn_sources((link, qtm), (queue, &stats), &tracker, &shutdown);
         tracker.spawn(control::run(ctx.clone(), shutdown.clone()));
         tracker.spawn(control::reload_on_sighup(ctx, shutdown.clone()));
-        tracker.spawn(log_stats(stats, every, shutdown.clone()));
+        tracker.spawn(log_stats(
+            stats,
+            self.config.stats_interval,
+            shutdown.clone(),
+        ));
         tracker.close();
         let result = processing.await;
         tracker.wait().await;
@@ -308,10 +308,11 @@ fn spawn_servers(
     (natnet, qtm)
 }
 
-/// Every source's task, its frames into `queue`: the OSC frame socket, the NatNet link when
-/// configured (its status into `stats`). A new source is one more task here.
+/// The task of every source but the OSC frame socket (the processing thread reads that), its
+/// frames into `queue`: the NatNet and QTM links when configured (their status into `stats`).
+/// A new source is one more task here.
 fn spawn_sources(
-    (osc, natnet_link, qtm): (OscSource, Option<Link>, Option<QtmInput>),
+    (natnet_link, qtm): (Option<Link>, Option<QtmInput>),
     (queue, stats): (Queue, &Arc<Mutex<Stats>>),
     tracker: &TaskTracker,
     shutdown: &CancellationToken,
@@ -334,15 +335,6 @@ fn spawn_sources(
             let _ = qtm::run(config, counters, shutdown, &mut sink, &mut on_status).await;
         });
     }
-    tracker.spawn(receive(osc, queue, shutdown.clone()));
-}
-
-/// The OSC frame socket's task, its frames into the queue.
-async fn receive(source: OscSource, queue: Queue, shutdown: CancellationToken) {
-    let mut sink = |frame: &SourceFrame<'_>, arrival: &Arrival| {
-        queue.push(frame, arrival);
-    };
-    super::sources::osc::run(source, &mut sink, shutdown).await;
 }
 
 /// The NatNet link's task: its frames into the queue, its status into `/status`.

@@ -1,7 +1,8 @@
 //! The live frame path allocates nothing once warm: 10,000 frames (109 markers, m = 20, some
 //! markers missing, a live emotion edit gliding, every output profile encoded) as `serve`
-//! runs them: the OSC source's demux, the processing queue (pooled buffers, shared labels),
-//! `Pipeline::handle_frame`, the sinks: every OSC profile encoded, and the monitor page's feed
+//! runs them: the OSC intake (allow-list, demux) on the processing thread, and, for every other
+//! frame, the processing queue the NatNet and QTM sources use (pooled buffers, shared labels,
+//! the doorbell), `Pipeline::handle_frame`, the sinks: every OSC profile encoded, and the monitor page's feed
 //! open (a 30 Hz snapshot of the stream published to the board). Then the same without a model
 //! (issue 37: frames passed through unedited). Counted by allocation-counter's global
 //! allocator (no `unsafe` here: the workspace forbids it).
@@ -12,11 +13,13 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use daemon::loopback::synthetic::{frame_into, random_model};
+use daemon::serve::allow::AllowList;
 use daemon::serve::monitor::Board;
 use daemon::serve::queue::Queue;
 use daemon::serve::sinks::osc::encode::EncodeOnly;
-use daemon::serve::sources::osc::OscDemux;
+use daemon::serve::sources::osc::{OscDemux, OscIntake};
 use daemon::serve::sources::{Answer, Arrival, InputCounters};
+use daemon::serve::wake::Doorbell;
 use engine::monitor::MonitorTap;
 use engine::pipeline::{Pipeline, PipelineConfig};
 use engine::{Needs, Processed, Sink};
@@ -74,8 +77,13 @@ fn the_frame_path_does_not_allocate() {
 fn ten_thousand_frames(mut p: Pipeline, model: &IcaModel, what: &str) {
     let counters = Arc::new(InputCounters::named("osc"));
     let mut demux = OscDemux::new(1_000, Arc::clone(&counters));
-    let (queue, ends) = Queue::new(64, 1_000, Arc::new(AtomicU64::new(0)));
+    let poll = mio::Poll::new().expect("a poll instance");
+    let waker = mio::Waker::new(poll.registry(), mio::Token(0)).expect("a waker");
+    let bell = Doorbell::new(waker);
+    let (queue, ends) = Queue::new(64, 1_000, Arc::new(AtomicU64::new(0)), bell);
     let answer = Arc::new(Answer::new(None));
+    let allow = (AllowList::anyone(), Arc::new(AtomicU64::new(0)));
+    let mut intake = OscIntake::new(allow, Arc::clone(&answer), Arc::clone(&counters), 1_000);
     let peer: SocketAddr = "127.0.0.1:7000".parse().expect("literal");
     let mut labels = Vec::new();
     let names = model.labels().to_vec();
@@ -88,6 +96,7 @@ fn ten_thousand_frames(mut p: Pipeline, model: &IcaModel, what: &str) {
     )
     .expect("labels");
     demux.handle_datagram(peer, &labels, &mut |_| {});
+    intake.datagram(peer, &labels, Instant::now(), &mut |_, _| {});
     // 16 distinct frames, every fourth with three markers missing.
     let mut buf = FrameBuf::with_max_markers(MARKERS);
     let mut datagrams: Vec<Vec<u8>> = (0..16)
@@ -118,7 +127,14 @@ fn ten_thousand_frames(mut p: Pipeline, model: &IcaModel, what: &str) {
             // frame number after "/mocap/frame\0\0\0\0" and ",ihbb\0\0\0"
             d[24..28].copy_from_slice(&n.to_be_bytes());
             let received = Instant::now();
-            // The OSC source's task: demux, then each frame copied into the queue.
+            if n % 2 == 0 {
+                // The processing thread reads the frame socket: the intake, then the engine.
+                intake.datagram(peer, d, received, &mut |frame, _| {
+                    p.handle_frame(frame, out)
+                });
+                continue;
+            }
+            // A queued source's task: decoded, then copied into the queue.
             demux.handle_datagram(peer, d, &mut |frame| {
                 let arrival = Arrival {
                     received,

@@ -19,7 +19,7 @@ use tokio_util::sync::CancellationToken;
 
 use super::allow::AllowList;
 use super::sources::natnet::{Link, NatNetConfig, NatNetStatus};
-use super::sources::osc::OscSource;
+use super::sources::osc::{OscIntake, OscSource};
 use super::sources::qtm::{QtmConfig, QtmStatus};
 use super::sources::{Answer, Arrival, InputCounters};
 use take::{Captured, Incoming, Take};
@@ -300,11 +300,12 @@ async fn osc(
     tracing::info!(target: "emoshift", listen = %bound, "record: waiting for frames");
     let source = OscSource {
         socket,
-        allow: AllowList::anyone(),
-        not_allowed: Arc::new(AtomicU64::new(0)),
-        answer: Arc::new(Answer::new(None)),
-        counters: Arc::new(InputCounters::named("osc")),
-        max_markers: protocol::MAX_FRAME_MARKERS,
+        intake: OscIntake::new(
+            (AllowList::anyone(), Arc::new(AtomicU64::new(0))),
+            Arc::new(Answer::new(None)),
+            Arc::new(InputCounters::named("osc")),
+            protocol::MAX_FRAME_MARKERS,
+        ),
     };
     let quiet = async {
         let mut tick = tokio::time::interval(Duration::from_millis(250));

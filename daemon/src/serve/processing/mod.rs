@@ -1,10 +1,17 @@
-//! The processing thread: the sources' frames off the [`super::queue`] through the [`Pipeline`] and
-//! straight out to every sink ([`Outputs`]: the OSC subscribers first); control commands
-//! between frames; counters merged into the shared [`Stats`] between bursts. While its queue
-//! is empty it parks, or polls around a steady source's next expected frame
-//! ([`ArrivalClock`]).
+//! The processing thread: OSC frames read off the frame socket on this thread, and the other
+//! sources' frames off the [`super::queue`], through the [`Pipeline`] and straight out to every
+//! sink ([`Outputs`]: the OSC subscribers first); control commands between frames; counters
+//! merged into the shared [`Stats`] between bursts. While nothing is waiting it sleeps in one
+//! [`Inbox`] wait on the socket and its doorbell, or polls around a steady source's next
+//! expected frame ([`ArrivalClock`]).
+//!
+//! One frame from an OSC source: [`Inbox::recv`] → [`OscIntake::datagram`] (allow-list, demux)
+//! → [`Pipeline::handle_frame`] → the [`Tap`] (latencies) → [`Outputs::handle_frame`] (each
+//! sink sends or stores it), all before the next datagram is read.
 
+mod inbox;
 mod requests;
+mod wait;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -13,15 +20,20 @@ use std::time::{Duration, Instant};
 
 use crossbeam_channel::Receiver;
 use engine::pipeline::{Pipeline, QUIET_SWEEPS, SWEEP_SECONDS};
-use engine::{Needs, Processed, Sink};
+use engine::{Needs, Processed, Sink, SourceFrame};
 use hdrhistogram::Histogram;
+use tokio_util::sync::CancellationToken;
 
 use super::arrival::{ArrivalClock, SpinWindow, Wait};
 use super::command::Request;
 use super::latency::{self, StreamLatency};
 use super::queue::{QueueEnds, QueuedFrame};
 use super::sinks::Outputs;
+use super::sources::osc::OscIntake;
+use super::sources::Arrival;
 use super::stats::{Stats, SubscriberStatus};
+pub(crate) use inbox::Inbox;
+use wait::Next;
 
 /// The processing thread merges its counters and histograms into the shared [`Stats`] (a
 /// lock, a histogram add and reset: tens of µs) only between bursts, at most this often: with
@@ -35,6 +47,23 @@ const MERGE_AT_LEAST: Duration = Duration::from_secs(1);
 const QUIET: Duration = Duration::from_millis(2);
 /// The processing thread parks at most this long between two looks at its counters.
 const IDLE: Duration = Duration::from_millis(50);
+/// Datagrams read off the frame socket, or frames off the queue, before the thread looks at
+/// its other inputs (a flood on one delays the others by this many frames at most).
+const BURST: usize = 64;
+
+/// What the processing thread takes frames and commands from.
+pub(crate) struct Inputs {
+    /// The OSC frame socket and the doorbell.
+    pub(crate) inbox: Inbox,
+    /// What the frame socket's datagrams become.
+    pub(crate) osc: OscIntake,
+    /// The other sources' frames.
+    pub(crate) queue: QueueEnds,
+    /// Control commands.
+    pub(crate) commands: Receiver<Request>,
+    /// Stops reading the socket; the queue is drained until its sources have stopped.
+    pub(crate) shutdown: CancellationToken,
+}
 
 /// What the processing thread shares with the rest of the service.
 pub(crate) struct Shared {
@@ -46,16 +75,15 @@ pub(crate) struct Shared {
     pub(crate) not_allowed: Arc<AtomicU64>,
 }
 
-/// What the processing thread does while its queue is empty.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Next {
-    /// Wait up to this long for a frame or a command; a timeout means nothing came for a
-    /// while, a good moment to tidy.
-    WaitIdle(Duration),
-    /// Wait up to this long: a planned wake-up before the next beat, nothing to tidy.
-    WaitBeat(Duration),
-    /// The counters were merged in the gap before the next tick; plan again.
-    PlanAgain,
+impl Shared {
+    /// Counters at zero beside `stats`.
+    pub(crate) fn new(stats: Arc<Mutex<Stats>>) -> Shared {
+        Shared {
+            stats,
+            queue_dropped: Arc::default(),
+            not_allowed: Arc::default(),
+        }
+    }
 }
 
 /// The processing thread's state.
@@ -65,8 +93,12 @@ pub(crate) struct Processing {
     arrival: ArrivalClock,
     poll_hits: u64,
     poll_misses: u64,
+    inbox: Inbox,
+    /// The OSC intake and its datagram buffer (taken out while a datagram is processed).
+    osc: Option<(OscIntake, Vec<u8>)>,
     queue: QueueEnds,
     cmd_rx: Receiver<Request>,
+    shutdown: CancellationToken,
     stats: Arc<Mutex<Stats>>,
     queue_dropped: Arc<AtomicU64>,
     not_allowed: Arc<AtomicU64>,
@@ -86,7 +118,7 @@ impl Processing {
     pub(crate) fn new(
         (pipeline, outputs): (Pipeline, Outputs),
         poll_window: Duration,
-        (queue, cmd_rx): (QueueEnds, Receiver<Request>),
+        inputs: Inputs,
         shared: Shared,
     ) -> Processing {
         Processing {
@@ -98,8 +130,11 @@ impl Processing {
             }),
             poll_hits: 0,
             poll_misses: 0,
-            queue,
-            cmd_rx,
+            inbox: inputs.inbox,
+            osc: Some((inputs.osc, vec![0u8; protocol::MAX_UDP_PAYLOAD + 1])),
+            queue: inputs.queue,
+            cmd_rx: inputs.commands,
+            shutdown: inputs.shutdown,
             stats: shared.stats,
             queue_dropped: shared.queue_dropped,
             not_allowed: shared.not_allowed,
@@ -111,64 +146,81 @@ impl Processing {
         }
     }
 
-    /// Runs until every source closed the queue, then closes the recording.
+    /// Runs until shutdown and every other source closed the queue, then closes the
+    /// recording.
     pub(crate) fn run(mut self) {
-        loop {
+        while !self.shutdown.is_cancelled() {
             let (timeout, idle) = match self.plan_wait() {
                 Next::WaitIdle(t) => (t, true),
                 Next::WaitBeat(t) => (t, false),
                 Next::PlanAgain => continue,
             };
-            crossbeam_channel::select! {
-                recv(self.queue.frames) -> msg => match msg {
-                    Ok(frame) => self.on_frame(frame),
-                    Err(_) => break,
-                },
-                recv(self.cmd_rx) -> cmd => if let Ok(cmd) = cmd {
-                    self.command(cmd);
-                },
-                default(timeout) => if idle { self.tidy() },
+            // A ring the plan's polling took still left its frame or command waiting.
+            let waiting = !self.queue.frames.is_empty() || !self.cmd_rx.is_empty();
+            let woke = self
+                .inbox
+                .wait(if waiting { Duration::ZERO } else { timeout });
+            if !self.take_inputs() && !woke && idle {
+                self.tidy();
             }
+        }
+        self.inbox.close_socket();
+        // The other sources stop on the same token; what they queued before is processed.
+        while let Ok(frame) = self.queue.frames.recv() {
+            self.on_queued(frame);
         }
         self.merge_stats();
         // Shutdown waits for every file to be complete.
         std::mem::take(&mut self.outputs.recorder).finish();
     }
 
-    /// How long to wait for the next frame or command (polling first when a beat is due).
-    fn plan_wait(&mut self) -> Next {
-        if !self.queue.frames.is_empty() {
-            return Next::WaitBeat(Duration::ZERO);
+    /// What is waiting: datagrams on the socket, queued frames, then commands, at most a
+    /// [`BURST`] of each kind of frame; whether there was anything.
+    fn take_inputs(&mut self) -> bool {
+        let mut took = self.read_socket();
+        for _ in 0..BURST {
+            let Ok(frame) = self.queue.frames.try_recv() else {
+                break;
+            };
+            self.on_queued(frame);
+            took = true;
         }
-        let now = Instant::now();
-        match self.arrival.plan(now) {
-            Wait::PollUntil(until) => {
-                if self.poll_until(until) {
-                    self.poll_hits += 1;
-                } else {
-                    self.poll_misses += 1;
-                }
-                Next::WaitIdle(IDLE)
-            }
-            Wait::ParkUntil(at) => {
-                let due = self.last_merge.elapsed() >= MERGE_EVERY && at - now > QUIET;
-                match self.arrival.burst_end() {
-                    // Merge in the gap, once this tick's frames are all in.
-                    Some(end) if due && end > now => Next::WaitBeat((end - now).min(at - now)),
-                    _ if due && self.cmd_rx.is_empty() => {
-                        self.tidy();
-                        Next::PlanAgain
-                    }
-                    _ => Next::WaitBeat((at - now).min(IDLE)),
-                }
-            }
-            Wait::Park => Next::WaitIdle(IDLE),
+        while let Ok(cmd) = self.cmd_rx.try_recv() {
+            self.command(cmd);
+            took = true;
         }
+        took
     }
 
-    fn on_frame(&mut self, frame: QueuedFrame) {
-        let received = frame.arrival.received;
-        self.process(frame);
+    /// Up to a [`BURST`] of datagrams off the frame socket, each through the engine before
+    /// the next is read.
+    fn read_socket(&mut self) -> bool {
+        let Some((mut osc, mut buf)) = self.osc.take() else {
+            return false;
+        };
+        let mut took = false;
+        for _ in 0..BURST {
+            let Some((len, peer)) = self.inbox.recv(&mut buf) else {
+                break;
+            };
+            took = true;
+            let received = Instant::now();
+            osc.datagram(peer, &buf[..len], received, &mut |frame, arrival| {
+                self.on_frame(frame, arrival);
+            });
+        }
+        self.osc = Some((osc, buf));
+        took
+    }
+
+    fn on_queued(&mut self, frame: QueuedFrame) {
+        self.on_frame(&frame.source(), &frame.arrival);
+        let _ = self.queue.free.try_send(frame.into_buffer());
+    }
+
+    fn on_frame(&mut self, frame: &SourceFrame<'_>, arrival: &Arrival) {
+        let received = arrival.received;
+        self.process(frame, arrival);
         // Only frames are queued (labels, bad packets and noise stay with their source), so
         // each sets the beat.
         self.arrival.frame_arrived(received);
@@ -190,36 +242,21 @@ impl Processing {
         self.last_merge = Instant::now();
     }
 
-    /// Polls the queues until something comes or `until`; `true` when a frame came. No
-    /// `spin_loop` hint: a hypervisor may take a run of PAUSE instructions as lock contention
-    /// and deschedule the CPU.
-    fn poll_until(&self, until: Instant) -> bool {
-        loop {
-            if !self.queue.frames.is_empty() {
-                return true;
-            }
-            if !self.cmd_rx.is_empty() || Instant::now() >= until {
-                return false;
-            }
-        }
-    }
-
     /// One frame through the engine to every sink; its source hears why if it was refused.
-    fn process(&mut self, frame: QueuedFrame) {
+    fn process(&mut self, frame: &SourceFrame<'_>, arrival: &Arrival) {
         let mut tap = Tap {
             outputs: &mut self.outputs,
-            received: frame.arrival.received,
-            captured: frame.arrival.captured,
+            received: arrival.received,
+            captured: arrival.captured,
             processed_us: &mut self.processed_us,
             latency: &mut self.latency,
         };
-        self.pipeline.handle_frame(&frame.source(), &mut tap);
+        self.pipeline.handle_frame(frame, &mut tap);
         if let Some(refusal) = self.pipeline.poll_refusal() {
-            if let Some(answer) = &frame.arrival.answer {
+            if let Some(answer) = &arrival.answer {
                 answer.tell(refusal.key.source, &refusal.why);
             }
         }
-        let _ = self.queue.free.try_send(frame.into_buffer());
     }
 
     /// Between frames: streams gone quiet, subscriptions whose lease ended, recordings done
@@ -228,6 +265,9 @@ impl Processing {
         self.outputs.recorder.tidy();
         if self.last_sweep.elapsed() >= Duration::from_secs(SWEEP_SECONDS) {
             self.last_sweep = Instant::now();
+            if let Some((osc, _)) = &mut self.osc {
+                osc.forget_quiet_sources();
+            }
             let gone = self.pipeline.forget_quiet_streams();
             if !gone.is_empty() {
                 self.outputs.handle_gone(&gone);

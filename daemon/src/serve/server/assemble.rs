@@ -1,12 +1,24 @@
 //! What the processing thread runs, put together from the config: the engine over the models
-//! (or without one: frames pass through) and every output.
+//! (or without one: frames pass through), every output, its OSC intake; and what control
+//! shares with it.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 use engine::pipeline::{Pipeline, PipelineConfig};
 use engine::Performer;
 use ica_core::model::IcaModel;
+use tokio::net::UdpSocket;
+use tokio_util::sync::CancellationToken;
+use tokio_util::task::TaskTracker;
+
+use crate::serve::command::Request;
+use crate::serve::control::{ControlCtx, Guard};
+use crate::serve::processing::Shared;
+use crate::serve::sources::osc::OscIntake;
+use crate::serve::sources::{Answer, InputCounters};
+use crate::serve::stats::Stats;
+use crate::serve::wake::Doorbell;
 
 use crate::serve::monitor::Feed;
 use crate::serve::sinks::natnet::NatNetSink;
@@ -64,4 +76,53 @@ pub(super) fn outputs(
         recorder: Recorder::new().telling(control_news),
         others,
     })
+}
+
+/// The frame socket's intake: `frames_allow`, refusals answered from the socket's clone
+/// `replies`.
+pub(super) fn osc_intake(
+    config: &Config,
+    shared: &Shared,
+    replies: std::net::UdpSocket,
+    counters: Arc<InputCounters>,
+    max_markers: usize,
+) -> OscIntake {
+    let allow = (config.frames_allow.clone(), Arc::clone(&shared.not_allowed));
+    let answer = Arc::new(Answer::new(Some(replies)));
+    OscIntake::new(allow, answer, counters, max_markers)
+}
+
+/// What the control task (and the monitor page) share: the socket, the way to the processing
+/// thread, the stats, the models and the guard.
+pub(super) fn control_ctx(
+    socket: UdpSocket,
+    (cmd_tx, bell): (crossbeam_channel::Sender<Request>, Doorbell),
+    stats: &Arc<Mutex<Stats>>,
+    (config, model): (&Config, &Option<Arc<IcaModel>>),
+    tracker: &TaskTracker,
+) -> ControlCtx {
+    ControlCtx {
+        socket: Arc::new(socket),
+        cmd_tx,
+        bell,
+        stats: Arc::clone(stats),
+        model_path: Arc::new(Mutex::new(config.model.clone())),
+        model: Arc::new(Mutex::new(model.clone())),
+        tracker: tracker.clone(),
+        guard: Arc::new(Guard::new(config)),
+    }
+}
+
+/// Wakes the processing thread when `shutdown` is cancelled, so it stops reading the frame
+/// socket at once.
+pub(super) fn ring_on_shutdown(
+    bell: Doorbell,
+    tracker: &TaskTracker,
+    shutdown: &CancellationToken,
+) {
+    let shutdown = shutdown.clone();
+    tracker.spawn(async move {
+        shutdown.cancelled().await;
+        bell.ring();
+    });
 }

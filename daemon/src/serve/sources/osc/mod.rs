@@ -1,9 +1,10 @@
-//! The OSC source: the frame socket's task. Datagrams from allowed senders go through the one
-//! [`OscDemux`]; each frame goes to the sink, and a source whose datagram is refused hears why
+//! The OSC source: datagrams from allowed senders go through the one [`OscDemux`]
+//! ([`OscIntake`]); each frame goes to the sink, and a source whose datagram is refused hears why
 //! ([`Answer`]). Every [`SWEEP_SECONDS`] the sources gone quiet are forgotten.
 
 pub mod demux;
 
+use std::net::SocketAddr;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -18,34 +19,84 @@ pub use demux::OscDemux;
 use super::{Answer, Arrival, FrameSink, InputCounters};
 use crate::serve::allow::AllowList;
 
-/// An OSC frame socket and who may send to it.
+/// An OSC frame socket and what its datagrams become (`record`'s capture runs it as a task).
 #[derive(Debug)]
 pub struct OscSource {
     /// The bound frame socket.
     pub socket: UdpSocket,
-    /// Senders whose datagrams are taken.
-    pub allow: AllowList,
-    /// Datagrams from other senders, dropped.
-    pub not_allowed: Arc<AtomicU64>,
-    /// Tells a source why its datagrams are refused.
-    pub answer: Arc<Answer>,
-    /// What the demux counts.
-    pub counters: Arc<InputCounters>,
-    /// Largest frame, markers.
-    pub max_markers: usize,
+    /// Who may send, and the demux.
+    pub intake: OscIntake,
+}
+
+/// The OSC source without its socket: who may send, the one [`OscDemux`], and who tells a
+/// refused source why. `record`'s task and `serve`'s processing thread (which reads the frame
+/// socket itself) both feed it datagrams.
+#[derive(Debug)]
+pub struct OscIntake {
+    allow: AllowList,
+    not_allowed: Arc<AtomicU64>,
+    answer: Arc<Answer>,
+    demux: OscDemux,
+}
+
+impl OscIntake {
+    /// Takes datagrams from senders `allow` lets in (counting the others in `not_allowed`),
+    /// frames of up to `max_markers`, counted in `counters`; refusals told through `answer`.
+    pub fn new(
+        (allow, not_allowed): (AllowList, Arc<AtomicU64>),
+        answer: Arc<Answer>,
+        counters: Arc<InputCounters>,
+        max_markers: usize,
+    ) -> OscIntake {
+        OscIntake {
+            allow,
+            not_allowed,
+            answer,
+            demux: OscDemux::new(max_markers, counters),
+        }
+    }
+
+    /// One datagram from `peer`, read off the socket at `received`: each frame in it to
+    /// `sink`; the source hears why if it is refused.
+    pub fn datagram(
+        &mut self,
+        peer: SocketAddr,
+        bytes: &[u8],
+        received: Instant,
+        sink: &mut FrameSink<'_>,
+    ) {
+        if !self.allow.allows(peer.ip()) {
+            self.not_allowed.fetch_add(1, Ordering::Relaxed);
+            return;
+        }
+        let answer = &self.answer;
+        self.demux.handle_datagram(peer, bytes, &mut |frame| {
+            let arrival = Arrival {
+                received,
+                captured: captured_at(
+                    frame.frame.header().capture_time_us,
+                    frame.time.clock,
+                    received,
+                ),
+                answer: Some(Arc::clone(answer)),
+                announced_rate_hz: None,
+            };
+            sink(frame, &arrival);
+        });
+        if let Some(refused) = self.demux.poll_refusal() {
+            answer.tell(refused.to, &refused.why);
+        }
+    }
+
+    /// Forgets the sources gone quiet (every [`SWEEP_SECONDS`]).
+    pub fn forget_quiet_sources(&mut self) {
+        self.demux.forget_quiet_sources();
+    }
 }
 
 /// Receives until `shutdown`: each frame of an allowed sender to `sink`, with its arrival.
 pub async fn run(source: OscSource, sink: &mut FrameSink<'_>, shutdown: CancellationToken) {
-    let OscSource {
-        socket,
-        allow,
-        not_allowed,
-        answer,
-        counters,
-        max_markers,
-    } = source;
-    let mut demux = OscDemux::new(max_markers, counters);
+    let OscSource { socket, mut intake } = source;
     let mut buf = vec![0u8; protocol::MAX_UDP_PAYLOAD + 1];
     let mut sweep = tokio::time::interval(Duration::from_secs(SWEEP_SECONDS));
     sweep.tick().await;
@@ -53,7 +104,7 @@ pub async fn run(source: OscSource, sink: &mut FrameSink<'_>, shutdown: Cancella
         let (len, peer) = tokio::select! {
             () = shutdown.cancelled() => break,
             _ = sweep.tick() => {
-                demux.forget_quiet_sources();
+                intake.forget_quiet_sources();
                 continue;
             }
             r = socket.recv_from(&mut buf) => match r {
@@ -65,27 +116,7 @@ pub async fn run(source: OscSource, sink: &mut FrameSink<'_>, shutdown: Cancella
                 }
             },
         };
-        if !allow.allows(peer.ip()) {
-            not_allowed.fetch_add(1, Ordering::Relaxed);
-            continue;
-        }
-        let received = Instant::now();
-        demux.handle_datagram(peer, &buf[..len], &mut |frame| {
-            let arrival = Arrival {
-                received,
-                captured: captured_at(
-                    frame.frame.header().capture_time_us,
-                    frame.time.clock,
-                    received,
-                ),
-                answer: Some(Arc::clone(&answer)),
-                announced_rate_hz: None,
-            };
-            sink(frame, &arrival);
-        });
-        if let Some(refused) = demux.poll_refusal() {
-            answer.tell(refused.to, &refused.why);
-        }
+        intake.datagram(peer, &buf[..len], Instant::now(), sink);
     }
 }
 
