@@ -109,6 +109,8 @@ struct Measured {
     servers: [Option<(Run, harness::Seen)>; 2],
     /// The daemon at the maximum rate.
     max: Run,
+    /// Each paced round's p50 and p99 ratios, daemon over relay.
+    round_ratios: Vec<[f64; 2]>,
 }
 
 /// The paced rounds (daemon and relay alternating, with the NatNet and monitor variants when
@@ -120,6 +122,7 @@ async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
     let monitor = args.monitor.as_deref();
     let mut daemon = through_daemon(model, (n, k), 120.0, per_round, w, None).await?;
     let mut relay = through_relay(model, n, k, per_round).await?;
+    let mut round_ratios = vec![ratios(&daemon.seen, &relay)];
     let mut watched: Option<Run> = None;
     let mut over_natnet: [Option<Run>; 2] = [None, None];
     let mut servers: [Option<(Run, harness::Seen)>; 2] = [None, None];
@@ -152,8 +155,11 @@ async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
             }
         }
         if round + 1 < rounds {
-            daemon.add(through_daemon(model, (n, k), 120.0, per_round, w, None).await?);
-            relay.add(&through_relay(model, n, k, per_round).await?);
+            let d = through_daemon(model, (n, k), 120.0, per_round, w, None).await?;
+            let r = through_relay(model, n, k, per_round).await?;
+            round_ratios.push(ratios(&d.seen, &r));
+            daemon.add(d);
+            relay.add(&r);
         }
     }
     let one = Duration::from_secs(1);
@@ -165,7 +171,27 @@ async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
         over_natnet,
         servers,
         max,
+        round_ratios,
     })
+}
+
+/// A round's p50 and p99 ratios, daemon over relay.
+fn ratios(daemon: &harness::Seen, relay: &harness::Seen) -> [f64; 2] {
+    [0.5, 0.99].map(|q| {
+        let r = relay.latency_us.value_at_quantile(q).max(1);
+        daemon.latency_us.value_at_quantile(q) as f64 / r as f64
+    })
+}
+
+/// The median of `values` (the mean of the middle two of an even count), and the range.
+fn median_range(mut values: Vec<f64>) -> (f64, f64, f64) {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n == 0 {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    let median = (values[(n - 1) / 2] + values[n / 2]) / 2.0;
+    (median, values[0], values[n - 1])
 }
 
 /// The paced rounds: what came through, the daemon's own stages, and its added latency
@@ -201,6 +227,14 @@ fn print_paced(args: &BenchArgs, r: &Measured) -> Result<()> {
         crate::out!(
             "{label} added latency: {d} µs (relay {r} µs, ratio {:.2}x)",
             d as f64 / r.max(1) as f64
+        );
+    }
+    for (i, label) in ["p50", "p99"].into_iter().enumerate() {
+        let (median, lo, hi) = median_range(r.round_ratios.iter().map(|x| x[i]).collect());
+        crate::out!(
+            "{label} ratio to the relay, median of {} interleaved rounds: {median:.2}x \
+             ({lo:.2}-{hi:.2}x)",
+            r.round_ratios.len()
         );
     }
     Ok(())
@@ -360,3 +394,6 @@ fn processing_rate(model: &IcaModel) -> Result<(f64, f64)> {
 fn peer_addr() -> SocketAddr {
     SocketAddr::from(([127, 0, 0, 1], 9))
 }
+
+#[cfg(test)]
+mod tests;
