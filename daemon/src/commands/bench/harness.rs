@@ -66,6 +66,11 @@ impl Run {
 /// its first snapshots and models.
 const WARMUP: Duration = Duration::from_millis(250);
 
+/// Warm-up frames each performer sends at `rate_hz` before the measured ones.
+pub(super) fn warmup_frames(rate_hz: f64) -> usize {
+    (rate_hz * WARMUP.as_secs_f64()) as usize
+}
+
 /// How long a round with the monitor waits for a page to open.
 const PAGE_WAIT: Duration = Duration::from_secs(60);
 
@@ -236,7 +241,7 @@ pub(super) async fn send_all(
         sources.push((Source::new(&labels, socket, to, false)?, xyz));
     }
     let frames = (rate_hz * secs.as_secs_f64()) as usize;
-    let warmup = (rate_hz * WARMUP.as_secs_f64()) as usize;
+    let warmup = warmup_frames(rate_hz);
     // Every frame is sent, however late: the max-rate run measures where frames go missing.
     let options = PacerOptions {
         max_behind_frames: u64::MAX,

@@ -27,6 +27,7 @@
 mod harness;
 mod natnet;
 mod qtm_client;
+mod rounds;
 mod server_outputs;
 
 use std::net::SocketAddr;
@@ -44,6 +45,7 @@ use crate::serve::sinks::osc::encode::{EncodeOnly, Profiles};
 use crate::serve::sources::osc::OscDemux;
 use crate::serve::sources::InputCounters;
 use harness::{through_daemon, through_relay, Run};
+use rounds::{median_range, ratios};
 use server_outputs::ServerOutput;
 
 const MARKERS: usize = 109;
@@ -173,25 +175,6 @@ async fn measure(model: &IcaModel, args: &BenchArgs) -> Result<Measured> {
         max,
         round_ratios,
     })
-}
-
-/// A round's p50 and p99 ratios, daemon over relay.
-fn ratios(daemon: &harness::Seen, relay: &harness::Seen) -> [f64; 2] {
-    [0.5, 0.99].map(|q| {
-        let r = relay.latency_us.value_at_quantile(q).max(1);
-        daemon.latency_us.value_at_quantile(q) as f64 / r as f64
-    })
-}
-
-/// The median of `values` (the mean of the middle two of an even count), and the range.
-fn median_range(mut values: Vec<f64>) -> (f64, f64, f64) {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n == 0 {
-        return (f64::NAN, f64::NAN, f64::NAN);
-    }
-    let median = (values[(n - 1) / 2] + values[n / 2]) / 2.0;
-    (median, values[0], values[n - 1])
 }
 
 /// The paced rounds: what came through, the daemon's own stages, and its added latency
@@ -326,6 +309,8 @@ fn print_watched(daemon: &Run, watched: &Run, clients: usize) -> Result<()> {
 fn print_max_rate(max: &Run) -> Result<()> {
     let received = max.seen.received as i64;
     let frames_in = max.get("frames_in");
+    let warmup = harness::warmup_frames(MAX_RATE_HZ) as i64;
+    let not_sent = max.get("dropped_send_buffer") + max.get("send_errors");
     crate::out!(
         "max rate: {} frames sent at {MAX_RATE_HZ} /s, {received} received, loss {:.3}%",
         max.sent,
@@ -334,13 +319,15 @@ fn print_max_rate(max: &Run) -> Result<()> {
     crate::out!(
         "  lost at the daemon's socket {}, dropped in the daemon {} (queue full {}, stale {}), \
          not sent {}, lost at the receiver's socket {}",
-        // The source counts a frame in as it decodes it, before the queue may drop it.
-        max.sent as i64 - frames_in,
+        // The source counts a frame in as it decodes it; the daemon's counts include the
+        // warm-up frames (one performer, one client), which the receiver does not count, and
+        // its datagrams the labels, which are not frames.
+        max.sent as i64 + warmup - frames_in,
         frames_in - max.get("frames_out"),
         max.get("frames_dropped"),
         max.get("dropped_stale"),
-        max.get("dropped_send_buffer") + max.get("send_errors"),
-        max.get("datagrams_sent") - received,
+        not_sent,
+        max.get("frames_out") - warmup - not_sent - received,
     );
     Ok(())
 }
@@ -394,6 +381,3 @@ fn processing_rate(model: &IcaModel) -> Result<(f64, f64)> {
 fn peer_addr() -> SocketAddr {
     SocketAddr::from(([127, 0, 0, 1], 9))
 }
-
-#[cfg(test)]
-mod tests;
