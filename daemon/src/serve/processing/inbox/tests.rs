@@ -51,3 +51,20 @@ fn the_bell_wakes_the_wait_and_shutdown_stops_reading() {
     assert!(!inbox.wait(Duration::from_millis(20)));
     assert_eq!(inbox.recv(&mut buf), None, "not read after shutdown");
 }
+
+/// A wait of a fraction of a millisecond (the timer's, not mio's) ends on its own, nothing
+/// having come, and not before its time; again and again, each arming the timer anew.
+#[test]
+fn a_sub_millisecond_wait_ends_on_the_timer() {
+    let (mut inbox, _bell, _sender, _addr) = inbox();
+    assert_eq!(inbox.recv(&mut [0u8; 8]), None);
+    for _ in 0..3 {
+        let wait = Duration::from_micros(1_500);
+        let start = std::time::Instant::now();
+        assert!(
+            !inbox.wait(wait),
+            "a timer's expiry is not something that came"
+        );
+        assert!(start.elapsed() >= wait, "woke after {:?}", start.elapsed());
+    }
+}
