@@ -38,7 +38,21 @@ pub(super) fn learn(
     options: &PrepOptions,
 ) -> Result<Learned> {
     let decided = decide_head(frames, labels, excluded, options)?;
-    learn_limits(frames, labels.len(), rate_hz, options, decided)
+    let (learned, _) = learn_limits(frames, labels.len(), rate_hz, options, decided)?;
+    Ok(learned)
+}
+
+/// The frames the glitch limits were measured on, in the decided head's coordinates and
+/// before any glitch check (there were no limits yet): what preparing them again would
+/// stabilise, so a pass over the same frames can run the glitch checks alone.
+#[derive(Debug, Clone, Default)]
+pub(super) struct HeadFrames {
+    /// Positions, frames x markers x 3 (head coordinates when stabilised).
+    pub xyz: Vec<f32>,
+    /// Missing flags (absent or not finite), frames x markers.
+    pub missing: Vec<bool>,
+    /// Stabilisation residual (mm) of each frame whose pose was estimated, in frame order.
+    pub residuals: Vec<f64>,
 }
 
 /// The head decision, and the head reference it makes (none without stabilisation).
@@ -90,7 +104,7 @@ pub(super) fn decide_head(
 }
 
 /// The glitch limits (speeds and plausible regions) measured on `frames` (`n` markers) in the
-/// coordinates of the `decided` head.
+/// coordinates of the `decided` head, and those frames in them.
 ///
 /// # Errors
 /// Preparing the frames failing.
@@ -100,13 +114,13 @@ pub(super) fn learn_limits(
     rate_hz: f64,
     options: &PrepOptions,
     decided: DecidedHead,
-) -> Result<Learned> {
+) -> Result<(Learned, HeadFrames)> {
     let mut capture = CaptureSettings {
         head: decided.head,
         max_speed_mm_s: None,
         bounds: None,
     };
-    let (head_xyz, head_missing, _, _) = run_prep(frames, n, rate_hz, &capture)?;
+    let (head_xyz, head_missing, _, residuals) = run_prep(frames, n, rate_hz, &capture)?;
     // The two are independent: at once on the current rayon pool.
     let (speed, bounds) = rayon::join(
         || match options.speed {
@@ -122,11 +136,17 @@ pub(super) fn learn_limits(
     );
     capture.max_speed_mm_s = speed;
     capture.bounds = bounds;
-    Ok(Learned {
+    let learned = Learned {
         capture,
         reference: decided.reference,
         head: decided.report,
-    })
+    };
+    let frames = HeadFrames {
+        xyz: head_xyz,
+        missing: head_missing,
+        residuals,
+    };
+    Ok((learned, frames))
 }
 
 /// The sample's frames end to end (`n` markers each): positions, missing flags, and each

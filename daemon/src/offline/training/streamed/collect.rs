@@ -47,6 +47,11 @@ impl Thinned {
         }
     }
 
+    /// Offers each of `values`, in order.
+    pub(super) fn extend(&mut self, values: &[f64]) {
+        values.iter().for_each(|&v| self.push(v));
+    }
+
     fn push(&mut self, v: f64) {
         if self.seen % self.stride == 0 {
             self.values.push(v);

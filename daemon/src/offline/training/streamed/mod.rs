@@ -46,7 +46,7 @@ use crate::offline::{LoadedTake, TakeInput};
 use collect::Collected;
 use finish::{fitted_model, measured, prep_report};
 use rayon::prelude::*;
-use read::{batches, TakePrep};
+use read::{batches, Stabilised, TakePrep};
 
 /// Sessions of at most this many frames (half a minute at 120 Hz) train in memory. Measured
 /// with `train --components 20` on synthetic sessions: 3,531 frames take 0.24-0.28 s either
@@ -136,10 +136,11 @@ fn streamed(
     pool: &ThreadPool,
     progress: &mut dyn Progress,
 ) -> Result<Trained> {
-    let learned = learn(&scanned, options, pool, progress)?;
+    let (learned, head_frames) = learn(&scanned, options, pool, progress)?;
     let total = scanned.total_frames();
     let (scanned, raw) = scanned.take_raw()?;
-    let (mut collected, head_residuals) = statistics(&scanned, raw, &learned, pool, progress)?;
+    let (mut collected, head_residuals) =
+        statistics(&scanned, raw, &learned, head_frames, pool, progress)?;
     let noise_mm = pool.install(|| noise_of_differences(&mut collected.noise_d2));
     let params = component_params(options, noise_mm);
     // Pass 3: the gaps.
@@ -186,19 +187,22 @@ fn streamed(
 }
 
 /// The head reference, then the glitch limits, learned from the scan's sample: two steps, so
-/// the head decision's time is reported apart.
+/// the head decision's time is reported apart. With the sample in the decided head's
+/// coordinates when it is the whole session (just stabilised: the statistics pass reuses it).
 fn learn(
     scanned: &scan::Scan,
     options: &TrainOptions,
     pool: &ThreadPool,
     progress: &mut dyn Progress,
-) -> Result<capture::Learned> {
+) -> Result<(capture::Learned, Option<capture::HeadFrames>)> {
     let (sample, labels, prep) = (&scanned.sample, &scanned.labels, &options.prep);
     progress.step("deciding the head", "frames", None);
     let decided = pool.install(|| capture::decide_head(sample, labels, &scanned.excluded, prep))?;
     progress.step("learning the glitch limits", "frames", None);
     let (n, rate_hz) = (labels.len(), scanned.rate_hz);
-    pool.install(|| capture::learn_limits(sample, n, rate_hz, prep, decided))
+    let (learned, head_frames) =
+        pool.install(|| capture::learn_limits(sample, n, rate_hz, prep, decided))?;
+    Ok((learned, scanned.sample_is_session().then_some(head_frames)))
 }
 
 /// Each marker's RMS residual over the residual frames (`channels` values each), and the slow
@@ -231,12 +235,17 @@ fn residual_measures(
 type Prepared = Option<(usize, Vec<read::PreparedTake>)>;
 
 /// How the scanned takes are prepared, with what was learned from the sample.
-fn take_prep<'a>(scanned: &'a scan::Scan, learned: &'a capture::Learned) -> TakePrep<'a> {
+fn take_prep<'a>(
+    scanned: &'a scan::Scan,
+    learned: &'a capture::Learned,
+    stabilised: Option<Stabilised<'a>>,
+) -> TakePrep<'a> {
     TakePrep {
         kept: &scanned.kept,
         spilled_markers: scanned.first_markers,
         rate_hz: scanned.rate_hz,
         capture: &learned.capture,
+        stabilised,
     }
 }
 
@@ -261,21 +270,39 @@ fn take_starts(frames: &[usize], record: usize) -> Vec<usize> {
     starts
 }
 
-/// Pass 2: every spilled frame prepared and collected; each reference marker's residual.
+/// A session the sample holds whole as the statistics pass reads it ([`Stabilised`]); its
+/// stabilisation residuals offered to `collected` at once, in the order the takes would.
+fn stabilised<'a>(
+    head_frames: Option<&'a capture::HeadFrames>,
+    scanned: &'a scan::Scan,
+    collected: &mut Collected,
+) -> Option<Stabilised<'a>> {
+    let frames = head_frames?;
+    collected.residuals.extend(&frames.residuals);
+    Some(Stabilised {
+        frames,
+        takes: &scanned.sample,
+        starts: take_starts(&scanned.take_frames, 1),
+    })
+}
+
+/// Pass 2: every spilled frame prepared (or only checked for glitches, when `head_frames`
+/// holds the session stabilised) and collected; each reference marker's residual.
 fn statistics(
     scanned: &scan::Scan,
     mut raw: spill::Spill,
     learned: &capture::Learned,
+    head_frames: Option<capture::HeadFrames>,
     pool: &ThreadPool,
     progress: &mut dyn Progress,
 ) -> Result<(Collected, Option<BTreeMap<String, f64>>)> {
-    let total = scanned.total_frames();
+    let (total, frames) = (scanned.total_frames(), &scanned.take_frames);
     progress.step("statistics", "frames", Some(total as u64));
     // The prepared frames go over the raw ones: each batch is collected after it was read.
     let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz, &mut raw)?;
     let mut refs = learned.capture.head.as_ref().map(RefResiduals::new);
-    let prep = take_prep(scanned, learned);
-    let frames = &scanned.take_frames;
+    let stabilised = stabilised(head_frames.as_ref(), scanned, &mut collected);
+    let prep = take_prep(scanned, learned, stabilised);
     let (batches, groups) = take_batches(frames);
     let record = 13 * scanned.first_markers;
     // Each batch is prepared on the pool while the previous one is collected here, so the
@@ -297,7 +324,8 @@ fn statistics(
             pool.install(|| {
                 starts
                     .par_windows(2)
-                    .map(|w| prep.prepare(&bytes[w[0]..w[1]]))
+                    .enumerate()
+                    .map(|(k, w)| prep.prepare(batches[b].start + k, &bytes[w[0]..w[1]]))
                     .collect::<Result<Vec<_>>>()
             })
         };

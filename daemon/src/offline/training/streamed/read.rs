@@ -12,6 +12,7 @@ use std::ops::Range;
 
 use super::sample::narrow;
 use super::spill::f32_values;
+use crate::offline::training::capture::HeadFrames;
 use crate::offline::ModelFrames;
 use engine::frame::FramePrep;
 
@@ -112,37 +113,57 @@ pub(super) struct TakePrep<'a> {
     pub spilled_markers: usize,
     pub rate_hz: f64,
     pub capture: &'a CaptureSettings,
+    /// The session already in head coordinates, when the sample holds it whole.
+    pub stabilised: Option<Stabilised<'a>>,
+}
+
+/// A session the head sample holds whole, as the glitch limits' pass prepared it
+/// ([`HeadFrames`]: head coordinates, no glitch check): preparing it again only runs the
+/// glitch checks, with the same result as stabilising every frame again (the pose is fitted
+/// before the checks, on the frame's mask as read).
+#[derive(Debug, Clone)]
+pub(super) struct Stabilised<'a> {
+    /// Every take's frames end to end.
+    pub frames: &'a HeadFrames,
+    /// Each take's frames as read (the sample): their masks before preparation.
+    pub takes: &'a [ModelFrames],
+    /// Where each take starts in `frames` (in frames).
+    pub starts: Vec<usize>,
 }
 
 impl TakePrep<'_> {
-    /// Prepares every frame of a take spilled by the first pass ([`super::scan`]).
+    /// Prepares every frame of take number `take`, spilled by the first pass
+    /// ([`super::scan`]) as `bytes`, or already stabilised ([`Stabilised`]).
     ///
     /// # Errors
     /// A frame buffer that does not match the markers (an internal invariant).
-    pub(super) fn prepare(&self, bytes: &[u8]) -> Result<PreparedTake> {
-        let raw = narrow(self.unspill(bytes), self.kept);
-        let n = self.kept.len();
-        let frames = raw.frames();
-        let mut prep = FramePrep::new(n, self.rate_hz, self.capture);
-        let mut out = PreparedTake {
-            frames,
-            xyz: Vec::with_capacity(frames * n * 3),
-            missing: Vec::with_capacity(frames * n),
-            raw_missing: Vec::new(),
-            glitches: 0,
-            residuals: Vec::new(),
-        };
-        for f in 0..frames {
-            let (p, m) = raw.frame(f);
-            let done = prep.prepare(p, m)?;
-            out.xyz.extend_from_slice(done.xyz);
-            out.missing.extend_from_slice(done.missing);
-            out.glitches += done.info.glitches;
-            if done.info.pose.is_some() && !done.info.pose_held {
-                out.residuals.push(done.info.residual_mm);
-            }
+    pub(super) fn prepare(&self, take: usize, bytes: &[u8]) -> Result<PreparedTake> {
+        if let Some(s) = &self.stabilised {
+            return self.check_glitches(s, take);
         }
+        let raw = narrow(self.unspill(bytes), self.kept);
+        let mut prep = FramePrep::new(self.kept.len(), self.rate_hz, self.capture);
+        let frames = (0..raw.frames()).map(|f| raw.frame(f));
+        let mut out = prepare_frames(&mut prep, raw.frames(), frames)?;
         out.raw_missing = raw.missing;
+        Ok(out)
+    }
+
+    /// Take number `take` of a stabilised session with the glitch checks run on it.
+    fn check_glitches(&self, s: &Stabilised<'_>, take: usize) -> Result<PreparedTake> {
+        let n = self.kept.len();
+        let (raw, start) = (&s.takes[take], s.starts[take]);
+        let range = start..start + raw.frames();
+        let xyz = &s.frames.xyz[range.start * n * 3..range.end * n * 3];
+        let missing = &s.frames.missing[range.start * n..range.end * n];
+        let checks = CaptureSettings {
+            head: None,
+            ..self.capture.clone()
+        };
+        let mut prep = FramePrep::new(n, self.rate_hz, &checks);
+        let frames = xyz.chunks_exact(n * 3).zip(missing.chunks_exact(n));
+        let mut out = prepare_frames(&mut prep, raw.frames(), frames)?;
+        out.raw_missing.clone_from(&raw.missing);
         Ok(out)
     }
 
@@ -161,6 +182,33 @@ impl TakePrep<'_> {
             markers: n,
         }
     }
+}
+
+/// `count` frames (positions and mask) through `prep`; the take's `raw_missing` left empty.
+fn prepare_frames<'f>(
+    prep: &mut FramePrep,
+    count: usize,
+    frames: impl Iterator<Item = (&'f [f32], &'f [bool])>,
+) -> Result<PreparedTake> {
+    let n = prep.markers();
+    let mut out = PreparedTake {
+        frames: count,
+        xyz: Vec::with_capacity(count * n * 3),
+        missing: Vec::with_capacity(count * n),
+        raw_missing: Vec::new(),
+        glitches: 0,
+        residuals: Vec::new(),
+    };
+    for (p, m) in frames {
+        let done = prep.prepare(p, m)?;
+        out.xyz.extend_from_slice(done.xyz);
+        out.missing.extend_from_slice(done.missing);
+        out.glitches += done.info.glitches;
+        if done.info.pose.is_some() && !done.info.pose_held {
+            out.residuals.push(done.info.residual_mm);
+        }
+    }
+    Ok(out)
 }
 
 /// A batch of prepared takes as the fit reads frames: values (frames x channels) and the

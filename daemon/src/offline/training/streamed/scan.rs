@@ -77,6 +77,15 @@ impl Scan {
     pub(super) fn total_frames(&self) -> usize {
         self.take_frames.iter().sum()
     }
+
+    /// The sample is the session: every take, whole, in order (a session within the
+    /// sample's budget with no empty take).
+    pub(super) fn sample_is_session(&self) -> bool {
+        self.sample.len() == self.take_frames.len()
+            && (self.sample.iter())
+                .zip(&self.take_frames)
+                .all(|(s, &f)| s.frames() == f)
+    }
 }
 
 /// Reads every take once (see the module docs); keeps them when the session has at most
