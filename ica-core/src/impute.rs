@@ -136,8 +136,9 @@ pub struct GapModel {
     loadings: Vec<f64>,
     /// Kept axes (m).
     axes: usize,
-    /// Variance per live channel the kept axes leave out.
-    residual: f64,
+    /// `σ² I + Σ a_c a_cᵀ` over every channel, m x m: a frame's system is this less its
+    /// missing channels' terms.
+    gram: DMatrix<f64>,
 }
 
 impl GapModel {
@@ -178,37 +179,39 @@ impl GapModel {
             }
         }
         let left: f64 = eigenvalues.iter().skip(m).sum();
+        let residual = left / live.len().max(1) as f64;
+        let mut gram = DMatrix::<f64>::zeros(m, m);
+        gram.fill_diagonal(residual.max(1e-12));
+        for row in loadings.chunks_exact(m.max(1)) {
+            add_outer(&mut gram, row, 1.0);
+        }
         GapModel {
             mean: mean.to_vec(),
             loadings,
             axes: m,
-            residual: left / live.len().max(1) as f64,
+            gram,
         }
     }
 
     /// Fills the `missing` channels of `frame` with their posterior mean given the others.
     pub fn fill(&self, frame: &mut [f32], missing: &[bool]) {
         let m = self.axes;
-        // `σ² I + Σ a_c a_cᵀ` and `Σ a_c (x_c − mean_c)` over the visible channels, summed in
-        // place channel after channel (the upper triangle, mirrored): the same sums as outer
-        // products added one by one, without a matrix product and two temporaries per channel.
-        let mut gram = DMatrix::<f64>::zeros(m, m);
-        gram.fill_diagonal(self.residual.max(1e-12));
+        // `σ² I + Σ a_c a_cᵀ` over the visible channels: the model's sum over every channel
+        // less the missing ones' terms (a few channels in a frame worth filling, against the
+        // half or more that are visible); `Σ a_c (x_c − mean_c)` over the visible ones.
+        let mut gram = self.gram.clone();
         let mut rhs = DVector::<f64>::zeros(m);
         for (c, &gone) in missing.iter().enumerate() {
+            let row = &self.loadings[c * m..(c + 1) * m];
             if gone {
+                add_outer(&mut gram, row, -1.0);
                 continue;
             }
-            let row = &self.loadings[c * m..(c + 1) * m];
             let centred = f64::from(frame[c]) - self.mean[c];
-            for (j, &aj) in row.iter().enumerate() {
-                for (i, &ai) in row[..=j].iter().enumerate() {
-                    gram[(i, j)] += ai * aj;
-                }
-                rhs[j] += aj * centred;
-            }
+            (rhs.as_mut_slice().iter_mut())
+                .zip(row)
+                .for_each(|(r, &a)| *r += a * centred);
         }
-        gram.fill_lower_triangle_with_upper_triangle();
         let Some(chol) = gram.cholesky() else {
             return;
         };
@@ -220,6 +223,19 @@ impl GapModel {
                 frame[c] = (self.mean[c] + fitted) as f32;
             }
         }
+    }
+}
+
+/// `gram += sign · a aᵀ` (m x m, `a` of m values), column by column of its storage as plain
+/// slices (nalgebra's element iterators cost several times the arithmetic here).
+fn add_outer(gram: &mut DMatrix<f64>, a: &[f64], sign: f64) {
+    let columns = gram.as_mut_slice().chunks_exact_mut(a.len().max(1));
+    for (column, &aj) in columns.zip(a) {
+        let scaled = sign * aj;
+        column
+            .iter_mut()
+            .zip(a)
+            .for_each(|(g, &ai)| *g += ai * scaled);
     }
 }
 

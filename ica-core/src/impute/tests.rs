@@ -35,3 +35,46 @@ fn gaps_are_filled_close_to_the_hidden_values() {
         / 400.0;
     assert!(err < 0.01 * spread, "error {err} vs spread {spread}");
 }
+
+#[test]
+fn a_fill_is_the_posterior_mean_given_the_visible_channels() {
+    // 12 channels (the last dead), 3 kept axes of 5: the fill from the model's whole-frame
+    // system less the missing channels must be the one from the visible channels alone.
+    let (channels, m) = (12, 3);
+    let live: Vec<usize> = (0..11).collect();
+    let basis = DMatrix::from_fn(11, m, |r, k| ((r * 7 + k * 3) % 5) as f64 * 0.3 - 0.55);
+    let eigenvalues = [4.0, 2.0, 1.0, 0.5, 0.25];
+    let mean: Vec<f64> = (0..channels).map(|c| c as f64 * 0.5).collect();
+    let model = GapModel::from_parts(&mean, &live, &basis, &eigenvalues, channels);
+    let mut frame: Vec<f32> = (0..channels)
+        .map(|c| (c as f32 * 1.3).sin() * 2.0)
+        .collect();
+    let missing: Vec<bool> = (0..channels).map(|c| [2, 5, 11].contains(&c)).collect();
+    // What the kept axes leave out, per live channel.
+    let (a, sigma2) = (&model.loadings, (0.5 + 0.25) / 11.0);
+    let mut gram = DMatrix::<f64>::identity(m, m) * sigma2;
+    let mut rhs = DVector::<f64>::zeros(m);
+    for c in (0..channels).filter(|&c| !missing[c]) {
+        let row = DVector::from_column_slice(&a[c * m..(c + 1) * m]);
+        gram += &row * row.transpose();
+        rhs += &row * (f64::from(frame[c]) - mean[c]);
+    }
+    let v = gram.cholesky().expect("positive definite").solve(&rhs);
+    let expected: Vec<f64> = (0..channels)
+        .map(|c| mean[c] + (0..m).map(|k| a[c * m + k] * v[k]).sum::<f64>())
+        .collect();
+    let before = frame.clone();
+    model.fill(&mut frame, &missing);
+    for c in 0..channels {
+        let want = if missing[c] {
+            expected[c]
+        } else {
+            f64::from(before[c])
+        };
+        assert!(
+            (f64::from(frame[c]) - want).abs() < 1e-5,
+            "channel {c}: {} against {want}",
+            frame[c]
+        );
+    }
+}
