@@ -246,12 +246,18 @@ impl Collected {
 
     /// Second differences within the take, from its second frame, every `stride` frames.
     fn add_noise(&mut self, samples: &[f32], mask: &[bool], frames: usize, stride: usize) {
+        // Frame after frame (three neighbouring rows at a time, read in order), each channel's
+        // differences still pushed in frame order.
         let c = self.channels;
         for f in (1..frames.saturating_sub(1)).step_by(stride) {
+            let rows = (f - 1) * c..(f + 2) * c;
+            let (x, m) = (&samples[rows.clone()], &mask[rows]);
+            let (x0, x1, x2) = (&x[..c], &x[c..2 * c], &x[2 * c..]);
+            let (m0, m1, m2) = (&m[..c], &m[c..2 * c], &m[2 * c..]);
             for (ch, d2) in self.noise_d2.iter_mut().enumerate() {
-                let at = |g: usize| (!mask[g * c + ch]).then(|| f64::from(samples[g * c + ch]));
-                if let (Some(a), Some(b), Some(n)) = (at(f - 1), at(f), at(f + 1)) {
-                    d2.push(a - 2.0 * b + n);
+                if !(m0[ch] || m1[ch] || m2[ch]) {
+                    let (a, b, n) = (x0[ch], x1[ch], x2[ch]);
+                    d2.push(f64::from(a) - 2.0 * f64::from(b) + f64::from(n));
                 }
             }
         }
