@@ -8,7 +8,9 @@
 //!    in memory instead ([`super::train`]: identical results; streaming is no slower at that
 //!    length, and faster on long sessions of many markers).
 //! 2. [`collect`]: every frame prepared once: the moments, the frames with gaps (spilled),
-//!    the glitch counts and what the quality report measures.
+//!    the glitch counts and what the quality report measures. A session the sample holds
+//!    whole is not stabilised again: the glitch checks run on the frames step 1 put in head
+//!    coordinates for the glitch limits.
 //! 3. [`gaps`]: the gap-filling rounds over the spilled frames only.
 //! 4. [`fit`]: the prepared frames read back, gaps filled, whitened and spilled; the restarts
 //!    on the subsample drawn during that pass; FastICA over the whitened spill, one pass per
