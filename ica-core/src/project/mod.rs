@@ -41,9 +41,9 @@ pub use crate::frame::FrameError;
 
 use crate::frame::FrameEdit;
 use crate::model::IcaModel;
-use kernels::{sub_into, Simd};
+use kernels::Simd;
 use masked::MaskedSolver;
-use tasks::{Axpy, MaskedSolve, NormalRhs};
+use tasks::{Axpy, CenterVisible, MaskedSolve, NormalRhs};
 
 /// Per-frame projector built from an [`IcaModel`]; owns every buffer it needs.
 #[derive(Debug, Clone)]
@@ -61,8 +61,9 @@ pub struct Projector {
     mixing: Vec<f32>,
     mean: Vec<f32>,
     centered: Vec<f32>,
-    observed: Vec<bool>,
     last_u: Vec<f32>,
+    /// Scratch: the hidden markers' indices in a masked frame.
+    gone: Vec<usize>,
     solver: MaskedSolver,
     /// The instruction set the kernels run with.
     simd: Simd,
@@ -109,8 +110,8 @@ impl Projector {
             mixing,
             mean,
             centered: vec![0.0; row_stride],
-            observed: vec![true; n],
             last_u: vec![0.0; m],
+            gone: vec![0; n / 3],
             solver: MaskedSolver::new(&rows, m, model.residual_variance()),
             simd,
             #[cfg(target_arch = "x86_64")]
@@ -181,8 +182,7 @@ impl Projector {
                 ..FrameStatus::default()
             });
         }
-        sub_into(x, &self.mean, &mut self.centered[..self.channels]);
-        Ok(self.project_gappy(missing, u))
+        Ok(self.project_gappy(x, missing, u))
     }
 
     /// Resynthesis `out = mean + M u`.
@@ -258,8 +258,7 @@ impl Projector {
                 });
             }
         }
-        sub_into(x, &self.mean, &mut self.centered[..self.channels]);
-        let status = self.project_gappy(missing, out_u);
+        let status = self.project_gappy(x, missing, out_u);
         edit.apply(out_u)?;
         self.resynth_into(out_u, out_x)?;
         Ok(status)
@@ -328,41 +327,27 @@ impl Projector {
         });
     }
 
-    /// The slow path: build the observed mask, then least squares or hold.
-    fn project_gappy(&mut self, missing: Option<&[bool]>, u: &mut [f32]) -> FrameStatus {
-        let mut missing_markers = 0;
-        for (i, (obs, c)) in self
-            .observed
-            .chunks_exact_mut(3)
-            .zip(self.centered.chunks_exact_mut(3))
-            .enumerate()
-        {
-            let gone = missing.is_some_and(|mask| mask[i]) || !c.iter().all(|v| v.is_finite());
-            obs.fill(!gone);
-            if gone {
-                // Zeroed so that `Mᵀ c` sums the observed rows only.
-                c.fill(0.0);
-                missing_markers += 1;
-            }
-        }
-        let hidden = 3 * missing_markers;
+    /// The slow path: centre the frame with the hidden markers zeroed, then least squares or
+    /// hold.
+    fn project_gappy(&mut self, x: &[f32], missing: Option<&[bool]>, u: &mut [f32]) -> FrameStatus {
+        let n = self.channels;
+        let missing_markers = self.simd.run(CenterVisible {
+            x,
+            mean: &self.mean,
+            missing,
+            centered: &mut self.centered[..n],
+            hidden: self.solver.hidden_mut(),
+            gone: &mut self.gone,
+        });
         let mut status = FrameStatus {
             masked: true,
             missing_markers,
             ..FrameStatus::default()
         };
-        if self.channels - hidden < self.components {
+        if n - 3 * missing_markers < self.components {
             u.copy_from_slice(&self.last_u);
             status.held = true;
             return status;
-        }
-        for (h, obs) in self
-            .solver
-            .hidden_mut()
-            .iter_mut()
-            .zip(self.observed.iter().step_by(3))
-        {
-            *h = !obs;
         }
         self.normal_rhs();
         let solve = self.simd.run(MaskedSolve {
