@@ -119,8 +119,29 @@ pub fn to_model_order(take: &Take, map: &LabelMap) -> ModelFrames {
 
 /// Gathers frames `range` of a take into model order.
 pub fn frames_in_model_order(take: &Take, map: &LabelMap, range: Range<usize>) -> ModelFrames {
+    let mut frames = ModelFrames {
+        xyz: Vec::new(),
+        missing: Vec::new(),
+        markers: map.model_to_take.len(),
+    };
+    frames_in_model_order_into(take, map, range, &mut frames);
+    frames
+}
+
+/// [`frames_in_model_order`] into the buffers of `out`, which a block reader reuses: a new
+/// `ModelFrames` per block was a fresh allocation of megabytes, whose pages the kernel
+/// faulted in and zeroed for every block (a tenth of `project`'s time on a long take).
+pub fn frames_in_model_order_into(
+    take: &Take,
+    map: &LabelMap,
+    range: Range<usize>,
+    out: &mut ModelFrames,
+) {
     let markers = map.model_to_take.len();
     let frames = range.len();
+    out.markers = markers;
+    out.xyz.clear();
+    out.missing.clear();
     let identity = markers == take.n_markers()
         && map
             .model_to_take
@@ -130,33 +151,25 @@ pub fn frames_in_model_order(take: &Take, map: &LabelMap, range: Range<usize>) -
     if identity {
         // The take has the model's markers in its order: one copy, then the missing
         // samples zeroed (as gathering leaves them).
-        let mut xyz = take.positions[range.start * markers * 3..range.end * markers * 3].to_vec();
-        let missing = take.missing[range.start * markers..range.end * markers].to_vec();
-        for (p, &gone) in xyz.chunks_exact_mut(3).zip(&missing) {
+        let (xyz, missing) = (&mut out.xyz, &mut out.missing);
+        xyz.extend_from_slice(&take.positions[range.start * markers * 3..range.end * markers * 3]);
+        missing.extend_from_slice(&take.missing[range.start * markers..range.end * markers]);
+        for (p, &gone) in xyz.chunks_exact_mut(3).zip(missing.iter()) {
             if gone {
                 p.fill(0.0);
             }
         }
-        return ModelFrames {
-            xyz,
-            missing,
-            markers,
-        };
+        return;
     }
-    let mut xyz = vec![0.0; frames * markers * 3];
-    let mut missing = vec![true; frames * markers];
+    out.xyz.resize(frames * markers * 3, 0.0);
+    out.missing.resize(frames * markers, true);
     for (k, f) in range.enumerate() {
         map.gather_into(
             take.frame(f),
             take.frame_missing(f),
-            &mut xyz[k * markers * 3..(k + 1) * markers * 3],
-            &mut missing[k * markers..(k + 1) * markers],
+            &mut out.xyz[k * markers * 3..(k + 1) * markers * 3],
+            &mut out.missing[k * markers..(k + 1) * markers],
         );
-    }
-    ModelFrames {
-        xyz,
-        missing,
-        markers,
     }
 }
 

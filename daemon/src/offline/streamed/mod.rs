@@ -25,7 +25,7 @@ use anyhow::{Context, Result};
 use ica_core::model::IcaModel;
 
 use crate::offline::progress::Progress;
-use crate::offline::takes::frames_in_model_order;
+use crate::offline::takes::frames_in_model_order_into;
 use crate::offline::ModelFrames;
 use engine::frame::{FrameProcessor, Prepared};
 use engine::LabelMap;
@@ -103,6 +103,32 @@ fn feed(
     Ok(())
 }
 
+/// The reader thread of [`run_pass`]: fills the buffers `free` returns with the next block
+/// and its frames in model order and sends them on `full`, until the input ends, fails, or
+/// the processing side has gone.
+fn read_blocks(
+    (source, map): (&mut Source, &LabelMap),
+    block_frames: usize,
+    free: std::sync::mpsc::Receiver<(replay::Take, ModelFrames)>,
+    full: std::sync::mpsc::SyncSender<ReadBlock>,
+) {
+    while let Ok((mut block, mut frames)) = free.recv() {
+        let read = match source.read_block(block_frames.max(1), &mut block) {
+            Ok(0) => return,
+            Ok(_) => {
+                let all = 0..block.n_frames();
+                frames_in_model_order_into(&block, map, all, &mut frames);
+                Ok((block, frames))
+            }
+            Err(e) => Err(e),
+        };
+        let failed = read.is_err();
+        if full.send(read).is_err() || failed {
+            return;
+        }
+    }
+}
+
 /// Projects every frame of `source` in blocks of `block_frames` and hands it to `sink` (until
 /// the sink [`FrameSink::is_past`] the next); reports progress as step `name`; returns the
 /// frames seen.
@@ -128,25 +154,17 @@ pub(crate) fn run_pass(
     let empty = source.empty_take();
     std::thread::scope(|s| -> Result<()> {
         let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<ReadBlock>(1);
-        let (free_tx, free_rx) = std::sync::mpsc::channel::<replay::Take>();
+        let (free_tx, free_rx) = std::sync::mpsc::channel::<(replay::Take, ModelFrames)>();
         for _ in 0..2 {
+            let frames = ModelFrames {
+                xyz: Vec::new(),
+                missing: Vec::new(),
+                markers: 0,
+            };
             // Cannot fail: the receiver is alive.
-            let _ = free_tx.send(empty.clone());
+            let _ = free_tx.send((empty.clone(), frames));
         }
-        s.spawn(move || {
-            // Ends when the input ends, fails, or the processing side has gone.
-            while let Ok(mut block) = free_rx.recv() {
-                let read = match source.read_block(block_frames.max(1), &mut block) {
-                    Ok(0) => return,
-                    Ok(_) => Ok(frames_in_model_order(&block, map, 0..block.n_frames())),
-                    Err(e) => Err(e),
-                };
-                let failed = read.is_err();
-                if full_tx.send(read.map(|frames| (block, frames))).is_err() || failed {
-                    return;
-                }
-            }
-        });
+        s.spawn(move || read_blocks((source, map), block_frames, free_rx, full_tx));
         for read in full_rx {
             let (block, frames) = read?;
             feed((&block, &frames), index, (&mut processor, &mut u), sink)?;
@@ -157,8 +175,8 @@ pub(crate) fn run_pass(
                 // Dropping the channels ends the reader.
                 break;
             }
-            // The reader may have finished: a buffer it will not need.
-            let _ = free_tx.send(block);
+            // The reader may have finished: buffers it will not need.
+            let _ = free_tx.send((block, frames));
         }
         Ok(())
     })?;
