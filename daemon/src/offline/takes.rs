@@ -86,7 +86,7 @@ pub fn load_session(path: &Path) -> Result<Session> {
 }
 
 /// A take in a model's marker order: frames x model markers x 3, and the missing mask.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct ModelFrames {
     /// Positions in model order (mm).
     pub xyz: Vec<f32>,
@@ -119,11 +119,7 @@ pub fn to_model_order(take: &Take, map: &LabelMap) -> ModelFrames {
 
 /// Gathers frames `range` of a take into model order.
 pub fn frames_in_model_order(take: &Take, map: &LabelMap, range: Range<usize>) -> ModelFrames {
-    let mut frames = ModelFrames {
-        xyz: Vec::new(),
-        missing: Vec::new(),
-        markers: map.model_to_take.len(),
-    };
+    let mut frames = ModelFrames::default();
     frames_in_model_order_into(take, map, range, &mut frames);
     frames
 }

@@ -158,13 +158,8 @@ pub(crate) fn run_pass(
         let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<ReadBlock>(1);
         let (free_tx, free_rx) = std::sync::mpsc::channel::<(replay::Take, ModelFrames)>();
         for _ in 0..2 {
-            let frames = ModelFrames {
-                xyz: Vec::new(),
-                missing: Vec::new(),
-                markers: 0,
-            };
             // Cannot fail: the receiver is alive.
-            let _ = free_tx.send((empty.clone(), frames));
+            let _ = free_tx.send((empty.clone(), ModelFrames::default()));
         }
         s.spawn(move || read_blocks((source, map), block_frames, free_rx, full_tx));
         for read in full_rx {
