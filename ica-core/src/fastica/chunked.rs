@@ -5,8 +5,9 @@
 //! blocks of [`BLOCK_FRAMES`] frames converted to f64, so its memory does not grow with the
 //! chunk, and allocates nothing after its first block.
 
-use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut};
+use nalgebra::{DMatrix, DMatrixViewMut};
 
+use super::fused::Fused;
 use super::Contrast;
 use crate::input::FitError;
 use crate::linalg::{mul_add, strided};
@@ -27,8 +28,7 @@ pub struct UpdateAccumulator {
     contrast: Contrast,
     step: usize,
     frames: usize,
-    b: DMatrix<f64>,
-    gp: Vec<f64>,
+    sums: Fused,
     scratch: Scratch,
 }
 
@@ -49,14 +49,12 @@ impl UpdateAccumulator {
 
     /// An empty accumulator tagged with the refinement step it belongs to.
     pub(crate) fn for_step(w: DMatrix<f64>, contrast: Contrast, step: usize) -> Self {
-        let (k, m) = w.shape();
         Self {
+            sums: Fused::new(&w),
             w,
             contrast,
             step,
             frames: 0,
-            b: DMatrix::zeros(m, k),
-            gp: vec![0.0; k],
             scratch: Scratch::default(),
         }
     }
@@ -71,17 +69,11 @@ impl UpdateAccumulator {
     /// # Errors
     /// [`FitError::RaggedSamples`] if the length is not a multiple of `m`.
     pub fn add_chunk<T: Copy + Into<f64>>(&mut self, z: &[T]) -> Result<(), FitError> {
-        let (k, m) = self.w.shape();
+        let m = self.w.ncols();
         check_frames(z, m)?;
         for chunk in z.chunks(BLOCK_FRAMES * m) {
             let nb = self.scratch.load(chunk, m);
-            let (zb, y) = self.scratch.sources(&self.w, nb);
-            for (gp, col) in self.gp.iter_mut().zip(y.chunks_exact_mut(nb)) {
-                *gp += self.contrast.apply(col);
-            }
-            let zv = DMatrixView::from_slice(zb, m, nb);
-            let yv = DMatrixView::from_slice(&y[..nb * k], nb, k);
-            mul_add(&mut self.b, 1.0, &zv, &yv, 1.0);
+            self.sums.add(&self.scratch.z, self.contrast);
             self.frames += nb;
         }
         Ok(())
@@ -96,10 +88,7 @@ impl UpdateAccumulator {
             return Err(FitError::AccumulatorMismatch);
         }
         self.frames += other.frames;
-        self.b += &other.b;
-        for (a, b) in self.gp.iter_mut().zip(&other.gp) {
-            *a += b;
-        }
+        self.sums.merge(&other.sums);
         Ok(())
     }
 
@@ -120,20 +109,22 @@ impl UpdateAccumulator {
     }
 
     /// The symmetric step damped by `mu` into `next` (same shape as `W`); returns the change.
-    pub(crate) fn step_into(mut self, mu: f64, next: &mut DMatrix<f64>) -> Result<f64, FitError> {
+    pub(crate) fn step_into(self, mu: f64, next: &mut DMatrix<f64>) -> Result<f64, FitError> {
         let inv_t = self.inv_frames()?;
-        self.gp.iter_mut().for_each(|g| *g *= inv_t);
+        let (b, mut gp) = self.sums.sums();
+        gp.iter_mut().for_each(|g| *g *= inv_t);
         Ok(super::symmetric::next_rotation(
-            &self.w, &self.b, &self.gp, inv_t, mu, next,
+            &self.w, &b, &gp, inv_t, mu, next,
         ))
     }
 
     /// The one-unit step of row 0: `E{z g(wᵀz)} - E{g'(wᵀz)} w` (not normalised).
     pub(crate) fn one_unit(&self) -> Result<Vec<f64>, FitError> {
         let inv_t = self.inv_frames()?;
-        let gp = self.gp[0] * inv_t;
+        let (b, gp) = self.sums.sums();
+        let gp = gp[0] * inv_t;
         Ok((0..self.w.ncols())
-            .map(|j| self.b[(j, 0)] * inv_t - gp * self.w[(0, j)])
+            .map(|j| b[(j, 0)] * inv_t - gp * self.w[(0, j)])
             .collect())
     }
 

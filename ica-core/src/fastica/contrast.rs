@@ -26,15 +26,19 @@ impl Contrast {
     /// Replaces each `y` by `g(y)` and returns the sum of `g'(y)`.
     pub(crate) fn apply(self, ys: &mut [f64]) -> f64 {
         match self {
-            Contrast::LogCosh => map_sum(ys, |y| {
-                let t = f64::from(tanh_f32(y as f32));
-                (t, 1.0 - t * t)
-            }),
-            Contrast::Exp => map_sum(ys, |y| {
-                let e = exp_fast(-0.5 * y * y);
-                (y * e, (1.0 - y * y) * e)
-            }),
-            Contrast::Cube => map_sum(ys, |y| (y * y * y, 3.0 * y * y)),
+            Contrast::LogCosh => map_sum(ys, logcosh_pair),
+            Contrast::Exp => map_sum(ys, exp_pair),
+            Contrast::Cube => map_sum(ys, cube_pair),
+        }
+    }
+
+    /// `(g(y), g'(y))` of one value, as [`Contrast::apply`] computes them.
+    #[inline(always)]
+    pub(crate) fn pair(self, y: f64) -> (f64, f64) {
+        match self {
+            Contrast::LogCosh => logcosh_pair(y),
+            Contrast::Exp => exp_pair(y),
+            Contrast::Cube => cube_pair(y),
         }
     }
 
@@ -150,21 +154,52 @@ pub(crate) fn exp_fast(x: f64) -> f64 {
 /// Sums, products with the data and the convergence test stay f64.
 #[inline(always)]
 pub(crate) fn tanh_f32(x: f32) -> f32 {
-    const CLAMP: f32 = 7.905_311;
-    let x = x.clamp(-CLAMP, CLAMP);
+    let x = x.clamp(-TANH_CLAMP, TANH_CLAMP);
     let x2 = x * x;
-    let mut p = -2.760_768_5e-16_f32;
-    p = p * x2 + 2.000_188e-13;
-    p = p * x2 - 8.604_672e-11;
-    p = p * x2 + 5.122_297e-8;
-    p = p * x2 + 1.485_722_4e-5;
-    p = p * x2 + 6.372_619_3e-4;
-    p = p * x2 + 4.893_524_6e-3;
-    let mut q = 1.198_258_4e-6_f32;
-    q = q * x2 + 1.185_347_1e-4;
-    q = q * x2 + 2.268_434_6e-3;
-    q = q * x2 + 4.893_525e-3;
+    let mut p = TANH_P[0];
+    for c in &TANH_P[1..] {
+        p = p * x2 + c;
+    }
+    let mut q = TANH_Q[0];
+    for c in &TANH_Q[1..] {
+        q = q * x2 + c;
+    }
     x * p / q
+}
+
+/// Where f32 `tanh` is 1: [`tanh_f32`] clamps its input to `±TANH_CLAMP`.
+pub(crate) const TANH_CLAMP: f32 = 7.905_311;
+/// [`tanh_f32`]'s numerator in `x²`, highest degree first (then times `x`).
+pub(crate) const TANH_P: [f32; 7] = [
+    -2.760_768_5e-16,
+    2.000_188e-13,
+    -8.604_672e-11,
+    5.122_297e-8,
+    1.485_722_4e-5,
+    6.372_619_3e-4,
+    4.893_524_6e-3,
+];
+/// [`tanh_f32`]'s denominator in `x²`, highest degree first.
+pub(crate) const TANH_Q: [f32; 4] = [1.198_258_4e-6, 1.185_347_1e-4, 2.268_434_6e-3, 4.893_525e-3];
+
+/// `(tanh y, 1 − tanh² y)`, tanh in f32 arithmetic.
+#[inline(always)]
+fn logcosh_pair(y: f64) -> (f64, f64) {
+    let t = f64::from(tanh_f32(y as f32));
+    (t, 1.0 - t * t)
+}
+
+/// `(y e^{−y²/2}, (1 − y²) e^{−y²/2})`.
+#[inline(always)]
+fn exp_pair(y: f64) -> (f64, f64) {
+    let e = exp_fast(-0.5 * y * y);
+    (y * e, (1.0 - y * y) * e)
+}
+
+/// `(y³, 3y²)`.
+#[inline(always)]
+fn cube_pair(y: f64) -> (f64, f64) {
+    (y * y * y, 3.0 * y * y)
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@
 mod chunked;
 mod contrast;
 mod deflation;
+mod fused;
 mod refine;
 mod subsample;
 mod symmetric;
