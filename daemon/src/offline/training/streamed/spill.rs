@@ -130,6 +130,23 @@ impl Spill {
         Ok(())
     }
 
+    /// Reads records `first..` into `out` (a whole number of records).
+    ///
+    /// # Errors
+    /// Reading fails, or `out` reaches past the last record.
+    pub(super) fn read_at(&mut self, first: usize, out: &mut [u8]) -> Result<()> {
+        debug_assert_eq!(out.len() % self.record_bytes, 0);
+        anyhow::ensure!(
+            first * self.record_bytes + out.len() <= self.records * self.record_bytes,
+            "a read past the spill file's last record"
+        );
+        self.file.flush().context("cannot write the spill file")?;
+        self.file
+            .get_ref()
+            .read_exact_at(out, (first * self.record_bytes) as u64)
+            .context("cannot read the spill file")
+    }
+
     /// Reads every record back in order, `chunk_records` at a time.
     ///
     /// # Errors
