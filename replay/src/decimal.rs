@@ -10,65 +10,96 @@
 
 /// Appends `value` to `out` exactly as `write!(out, "{value}")` would.
 pub fn push_f32(out: &mut String, value: f32) {
-    if !value.is_finite() {
-        // "NaN", "inf", "-inf": rare, left to std.
-        use std::fmt::Write as _;
-        write!(out, "{value}").expect("writing to a String cannot fail");
-        return;
-    }
     let mut buffer = zmij::Buffer::new();
-    let text = buffer.format_finite(value);
-    let (negative, text) = match text.strip_prefix('-') {
-        Some(rest) => (true, rest),
-        None => (false, text),
-    };
-    let (mantissa, exponent) = match text.split_once(['e', 'E']) {
-        Some((m, e)) => (m, e.parse::<i32>().expect("zmij writes a decimal exponent")),
-        None => (text, 0),
-    };
-    let (whole, fraction) = mantissa.split_once('.').unwrap_or((mantissa, ""));
-    // The significant digits are `whole` then `fraction` without the zeros at either end,
-    // the decimal point `point` digits from their start.
-    let mut point = whole.len() as i32 + exponent;
-    let whole_digits = whole.trim_start_matches('0');
-    point -= (whole.len() - whole_digits.len()) as i32;
-    let fraction = if whole_digits.is_empty() {
-        let trimmed = fraction.trim_start_matches('0');
-        point -= (fraction.len() - trimmed.len()) as i32;
-        trimmed
-    } else {
-        fraction
-    };
-    let fraction = fraction.trim_end_matches('0');
-    let digits = match fraction.is_empty() {
-        // `1200.0`: the digits are `12`.
-        true => Digits(whole_digits.trim_end_matches('0'), ""),
-        false => Digits(whole_digits, fraction),
-    };
-    let count = digits.len() as i32;
-    if exact_digits(value) == Some(count + 1) {
-        // Halfway between two shortest candidates: zmij rounds the tie to even, std does
-        // not always; std decides these few.
-        use std::fmt::Write as _;
-        write!(out, "{value}").expect("writing to a String cannot fail");
+    if !value.is_finite() {
+        // "NaN", "inf", "-inf", as std writes them.
+        out.push_str(buffer.format(value));
         return;
     }
-    if negative {
-        out.push('-');
+    let text = buffer.format_finite(value);
+    if let Some(exact) = exact_digits(value) {
+        if exact == Layout::of(text).digits.len() as i32 + 1 {
+            // Halfway between two shortest candidates: zmij rounds the tie to even, std does
+            // not always; std decides these few.
+            use std::fmt::Write as _;
+            write!(out, "{value}").expect("writing to a String cannot fail");
+            return;
+        }
     }
-    if count == 0 {
-        out.push('0');
-    } else if point <= 0 {
-        out.push_str("0.");
-        push_zeros(out, -point);
-        digits.push_range(out, 0, count);
-    } else if point >= count {
-        digits.push_range(out, 0, count);
-        push_zeros(out, point - count);
-    } else {
-        digits.push_range(out, 0, point);
-        out.push('.');
-        digits.push_range(out, point, count);
+    if !text.contains('e') {
+        // Positional already (`0.00123`, `12.5`, `1200.0`): std writes it without `.0`.
+        out.push_str(text.strip_suffix(".0").unwrap_or(text));
+        return;
+    }
+    Layout::of(text).push(out);
+}
+
+/// A zmij text taken apart: sign, significant digits, and where the decimal point falls.
+struct Layout<'a> {
+    negative: bool,
+    digits: Digits<'a>,
+    /// The point's place, in digits from the first significant one (may be negative or past
+    /// the last).
+    point: i32,
+}
+
+impl<'a> Layout<'a> {
+    fn of(text: &'a str) -> Layout<'a> {
+        let (negative, text) = match text.strip_prefix('-') {
+            Some(rest) => (true, rest),
+            None => (false, text),
+        };
+        let (mantissa, exponent) = match text.split_once('e') {
+            Some((m, e)) => (m, e.parse::<i32>().expect("zmij writes a decimal exponent")),
+            None => (text, 0),
+        };
+        let (whole, fraction) = mantissa.split_once('.').unwrap_or((mantissa, ""));
+        // The significant digits are `whole` then `fraction` without the zeros at either end.
+        let mut point = whole.len() as i32 + exponent;
+        let whole_digits = whole.trim_start_matches('0');
+        point -= (whole.len() - whole_digits.len()) as i32;
+        let fraction = if whole_digits.is_empty() {
+            let trimmed = fraction.trim_start_matches('0');
+            point -= (fraction.len() - trimmed.len()) as i32;
+            trimmed
+        } else {
+            fraction
+        };
+        let fraction = fraction.trim_end_matches('0');
+        let digits = if fraction.is_empty() {
+            // `1200.0`: the digits are `12`.
+            Digits(whole_digits.trim_end_matches('0'), "")
+        } else {
+            Digits(whole_digits, fraction)
+        };
+        Layout {
+            negative,
+            digits,
+            point,
+        }
+    }
+
+    /// Appends the number as std lays it out.
+    fn push(&self, out: &mut String) {
+        let (digits, point) = (&self.digits, self.point);
+        if self.negative {
+            out.push('-');
+        }
+        let count = digits.len() as i32;
+        if count == 0 {
+            out.push('0');
+        } else if point <= 0 {
+            out.push_str("0.");
+            push_zeros(out, -point);
+            digits.push_range(out, 0, count);
+        } else if point >= count {
+            digits.push_range(out, 0, count);
+            push_zeros(out, point - count);
+        } else {
+            digits.push_range(out, 0, point);
+            out.push('.');
+            digits.push_range(out, point, count);
+        }
     }
 }
 
