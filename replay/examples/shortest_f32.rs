@@ -1,5 +1,5 @@
 //! Proves `replay::decimal::push_f32` writes every `f32` as std's `Display` does: all 2^32 bit
-//! patterns (about five minutes on one core of the team's machine), or every STRIDE-th.
+//! patterns (12-15 minutes on one core of the team's loaded machine), or every STRIDE-th.
 //!
 //! Usage: `cargo run --release -p replay --example shortest_f32 -- [STRIDE]`
 
