@@ -13,6 +13,7 @@
 pub mod blocks;
 pub mod c3d;
 pub mod csv;
+pub mod decimal;
 mod durable;
 pub mod error;
 pub mod file;

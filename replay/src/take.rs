@@ -141,11 +141,14 @@ impl Take {
         let n = self.n_markers();
         assert_eq!(xyz.len(), n * 3, "frame must hold markers x 3 values");
         assert_eq!(missing.len(), n, "mask must hold one flag per marker");
-        for (m, &gone) in missing.iter().enumerate() {
-            if gone {
-                self.positions.extend_from_slice(&[0.0; 3]);
-            } else {
-                self.positions.extend_from_slice(&xyz[m * 3..m * 3 + 3]);
+        // Grown once and filled branch-free (one extend per marker was a cost of `edit`'s
+        // output assembly, issue 35).
+        let p0 = self.positions.len();
+        self.positions.resize(p0 + n * 3, 0.0);
+        let out = self.positions[p0..].chunks_exact_mut(3);
+        for ((o, p), &gone) in out.zip(xyz.chunks_exact(3)).zip(missing) {
+            for (o, &v) in o.iter_mut().zip(p) {
+                *o = if gone { 0.0 } else { v };
             }
         }
         self.missing.extend_from_slice(missing);

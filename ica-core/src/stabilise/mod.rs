@@ -21,10 +21,12 @@ mod pairs;
 mod rotation;
 mod sample;
 pub mod search;
+mod transform;
 
 pub use assess::{GroupAssessment, MIN_MOTION_MM, MOTION_FACTOR};
 pub use sample::MarkerFrames;
 pub use search::{assess_named, choose, search_reference, Choice, ReferenceSearch, SearchParams};
+pub use transform::{to_head_into, to_world_into};
 
 /// Why stabilisation could not be set up.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -284,34 +286,6 @@ pub(crate) fn centre(points: &mut [[f64; 3]]) {
         for a in 0..3 {
             p[a] -= mean[a];
         }
-    }
-}
-
-/// Maps a frame from world to head coordinates: `head = Rᵀ (world − t)`. Missing samples are
-/// copied unchanged.
-pub fn to_head_into(pose: &Pose, world: &[f32], missing: &[bool], head: &mut [f32]) {
-    let inv = pose.rotation.transpose();
-    for (m, &gone) in missing.iter().enumerate() {
-        let i = m * 3;
-        if gone {
-            head[i..i + 3].copy_from_slice(&world[i..i + 3]);
-            continue;
-        }
-        let h = inv * (point(world, m) - pose.translation);
-        head[i] = h.x as f32;
-        head[i + 1] = h.y as f32;
-        head[i + 2] = h.z as f32;
-    }
-}
-
-/// Maps a frame from head to world coordinates: `world = R · head + t`.
-pub fn to_world_into(pose: &Pose, head: &[f32], world: &mut [f32]) {
-    for m in 0..head.len() / 3 {
-        let i = m * 3;
-        let w = pose.rotation * point(head, m) + pose.translation;
-        world[i] = w.x as f32;
-        world[i + 1] = w.y as f32;
-        world[i + 2] = w.z as f32;
     }
 }
 

@@ -95,3 +95,43 @@ fn bad_setups_are_errors() {
         StabiliseError::Degenerate
     );
 }
+
+/// Issue 35: the vectorised transforms give nalgebra's products to the bit, for marker counts
+/// around the groups of four and with missing markers copied.
+#[test]
+fn transforms_match_nalgebra_products_to_the_bit() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(35);
+    for markers in [1, 3, 4, 5, 7, 8, 109] {
+        for _ in 0..50 {
+            let angles: [f64; 3] = std::array::from_fn(|_| rng.random_range(-3.0..3.0));
+            let pose = Pose {
+                rotation: *Rotation3::from_euler_angles(angles[0], angles[1], angles[2]).matrix(),
+                translation: Vector3::from_fn(|_, _| rng.random_range(-2000.0..2000.0)),
+            };
+            let world: Vec<f32> = (0..markers * 3)
+                .map(|_| rng.random_range(-3000.0..3000.0))
+                .collect();
+            let missing: Vec<bool> = (0..markers).map(|_| rng.random_bool(0.2)).collect();
+            let (mut head, mut back) = (vec![0.0; markers * 3], vec![0.0; markers * 3]);
+            to_head_into(&pose, &world, &missing, &mut head);
+            to_world_into(&pose, &head, &mut back);
+            let inv = pose.rotation.transpose();
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            for m in 0..markers {
+                let p = point(&world, m);
+                let h = inv * (p - pose.translation);
+                let want: [f32; 3] = match missing[m] {
+                    true => [p.x as f32, p.y as f32, p.z as f32],
+                    false => [h.x as f32, h.y as f32, h.z as f32],
+                };
+                let got = bits(&head[m * 3..m * 3 + 3]);
+                assert_eq!(got, bits(&want), "head, marker {m} of {markers}");
+                let w = pose.rotation * point(&head, m) + pose.translation;
+                let want = [w.x as f32, w.y as f32, w.z as f32];
+                let got = bits(&back[m * 3..m * 3 + 3]);
+                assert_eq!(got, bits(&want), "world, marker {m} of {markers}");
+            }
+        }
+    }
+}

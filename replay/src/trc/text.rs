@@ -247,10 +247,9 @@ pub(crate) fn bad_cell(
 }
 
 /// Formats a sample cell for writing: the shortest text that reads back to the same `f32`, so
-/// round trips are exact and files stay compact.
+/// round trips are exact and files stay compact (std's `{}`, written faster).
 pub(crate) fn push_sample(out: &mut String, value: f32) {
-    use std::fmt::Write as _;
-    write!(out, "{value}").expect("writing to a String cannot fail");
+    crate::decimal::push_f32(out, value);
 }
 
 /// Rejects labels holding a character the format uses as a separator, before anything is

@@ -56,7 +56,7 @@ impl<'a> Output<'a> {
             self.xyz[slot * 3..slot * 3 + 3].copy_from_slice(&source[t * 3..t * 3 + 3]);
             self.missing[slot] = source_missing[t];
         }
-        if self.xyz.iter().any(|v| !v.is_finite()) {
+        if !protocol::all_finite(&self.xyz) {
             bail!("frame {f}: the edit produced a non-finite position");
         }
         self.take.push_frame(&self.xyz, &self.missing);

@@ -113,8 +113,9 @@ impl Csv<'_> {
             let time = f as f64 / self.rate_hz;
             self.line.clear();
             write!(self.line, "{},{time:.6}", self.first_frame + f as i64)?;
-            for v in u {
-                write!(self.line, ",{v}")?;
+            for &v in u {
+                self.line.push(',');
+                replay::decimal::push_f32(&mut self.line, v);
             }
             self.line.push('\n');
             self.out.write_all(self.line.as_bytes())?;
