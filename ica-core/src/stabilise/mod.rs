@@ -23,7 +23,7 @@ mod sample;
 pub mod search;
 
 pub use assess::{GroupAssessment, MIN_MOTION_MM, MOTION_FACTOR};
-pub use sample::MarkerFrames;
+pub use sample::{MarkerFrames, TakeFrames};
 pub use search::{assess_named, choose, search_reference, Choice, ReferenceSearch, SearchParams};
 
 /// Why stabilisation could not be set up.
