@@ -15,6 +15,7 @@
 //!   (high).
 
 use nalgebra::{Matrix3, SMatrix, SVector, SymmetricEigen, Vector3};
+use rayon::prelude::*;
 
 use super::sample::Sample;
 use super::{centre, kabsch, point, Pose};
@@ -230,8 +231,9 @@ fn fit_all(sample: &Sample, group: &[usize], template: &[[f64; 3]], frames: &[us
 
 /// Mean head-coordinate position of each other marker.
 fn head_means(sample: &Sample, fits: &Fits, others: &[usize]) -> Vec<Vector3<f64>> {
+    // Markers at once on the current rayon pool, collected in order.
     others
-        .iter()
+        .par_iter()
         .filter_map(|&m| {
             let (mut sum, mut count) = (Vector3::zeros(), 0usize);
             for (&f, pose) in fits.frames.iter().zip(&fits.poses) {
@@ -314,10 +316,12 @@ fn pose_params(p: &Pose) -> SVector<f64, 6> {
 /// the pose parameters.
 fn leakage(sample: &Sample, fits: &Fits, others: &[usize]) -> f64 {
     let params: Vec<SVector<f64, 6>> = fits.poses.iter().map(pose_params).collect();
-    let mut rows = Vec::with_capacity(params.len());
+    // Markers at once on the current rayon pool (a shortlist of a few groups would keep one
+    // core busy and the other idle), each into its own buffer of rows; the median does not
+    // depend on the order.
     let mut shares: Vec<f64> = others
-        .iter()
-        .filter_map(|&m| {
+        .par_iter()
+        .map_init(Vec::new, |rows, &m| {
             rows.clear();
             rows.extend(fits.frames.iter().zip(&fits.poses).zip(&params).filter_map(
                 |((&f, pose), p)| {
@@ -326,8 +330,9 @@ fn leakage(sample: &Sample, fits: &Fits, others: &[usize]) -> f64 {
                     Some((p.push(1.0), head))
                 },
             ));
-            explained_share(&rows)
+            explained_share(rows)
         })
+        .flatten()
         .collect();
     median(&mut shares)
 }

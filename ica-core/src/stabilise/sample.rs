@@ -77,11 +77,14 @@ impl Sample {
         sample
     }
 
-    /// [`Sample::columns`] from the frame-major storage, written column by column.
+    /// [`Sample::columns`] from the frame-major storage, written column by column, columns at
+    /// once on the current rayon pool.
     fn transposed(&self) -> Vec<f32> {
+        use rayon::prelude::*;
         let (n, t) = (self.markers, self.present.len() / self.markers.max(1));
         let mut columns = vec![0.0; n * 3 * t];
-        for (c, column) in columns.chunks_exact_mut(t.max(1)).enumerate() {
+        let columns_of = columns.par_chunks_exact_mut(t.max(1)).enumerate();
+        columns_of.for_each(|(c, column)| {
             let (m, axis) = (c / 3, c % 3);
             for (f, v) in column.iter_mut().enumerate() {
                 let i = f * n + m;
@@ -91,7 +94,7 @@ impl Sample {
                     f32::NAN
                 };
             }
-        }
+        });
         columns
     }
 
