@@ -149,12 +149,14 @@ fn template(sample: &Sample, group: &[usize], frames: &[usize]) -> Option<Vec<[f
     centre(&mut template);
     let mut sum = vec![Vector3::<f64>::zeros(); group.len()];
     let mut count = vec![0usize; group.len()];
-    let mut pairs = Pairs::with_capacity(group.len());
     for _ in 0..3 {
         sum.fill(Vector3::zeros());
         count.fill(0);
-        for &f in frames {
-            let Some(pose) = fit(sample, group, &template, f, &mut pairs) else {
+        for (&f, pose) in frames
+            .iter()
+            .zip(fit_each(sample, group, &template, frames))
+        {
+            let Some(pose) = pose else {
                 continue;
             };
             let inv = pose.rotation.transpose();
@@ -196,6 +198,25 @@ fn fit(
     kabsch(pairs.iter().map(|(t, q)| (t, *q))).map(|(pose, _)| pose)
 }
 
+/// The group's pose in each of `frames` (`None` where it cannot be fitted), frames at once on
+/// the current rayon pool: the fits are most of an assessment, and a shortlist of a few groups
+/// assessed at once would leave a core idle. Collected in order, so what the caller sums over
+/// them is summed in the same order whatever the thread count.
+fn fit_each(
+    sample: &Sample,
+    group: &[usize],
+    template: &[[f64; 3]],
+    frames: &[usize],
+) -> Vec<Option<Pose>> {
+    frames
+        .par_iter()
+        .map_init(
+            || Pairs::with_capacity(group.len()),
+            |pairs, &f| fit(sample, group, template, f, pairs),
+        )
+        .collect()
+}
+
 /// Poses and residuals of the group in every one of `frames` where it can be fitted.
 fn fit_all(sample: &Sample, group: &[usize], template: &[[f64; 3]], frames: &[usize]) -> Fits {
     let mut fits = Fits {
@@ -204,9 +225,8 @@ fn fit_all(sample: &Sample, group: &[usize], template: &[[f64; 3]], frames: &[us
         residual_sq: Vec::with_capacity(frames.len()),
         per_marker_sq: Vec::with_capacity(frames.len() * group.len()),
     };
-    let mut pairs = Pairs::with_capacity(group.len());
-    for &f in frames {
-        let Some(pose) = fit(sample, group, template, f, &mut pairs) else {
+    for (&f, pose) in frames.iter().zip(fit_each(sample, group, template, frames)) {
+        let Some(pose) = pose else {
             continue;
         };
         let (mut sq, mut used) = (0.0, 0usize);
