@@ -121,10 +121,9 @@ pub(crate) fn assess_group(
     res.truncate(((res.len() as f64 * 0.99).ceil() as usize).max(1));
     let fre_sq = res.iter().sum::<f64>() / res.len() as f64;
     let deformation_mm = (fre_sq / (1.0 - 2.0 / k as f64).max(1.0 / 3.0)).sqrt();
-    let targets = head_means(sample, &fits, &others);
+    let (targets, leakage) = seen_from_head(sample, &fits, &others);
     let pose_error_mm = tre(&template, &targets, deformation_mm);
     let motion_mm = motion(&fits, &targets);
-    let leakage = leakage(sample, &fits, &others);
     Some(GroupAssessment {
         markers: group.to_vec(),
         marker_residual_mm,
@@ -249,24 +248,6 @@ fn fit_all(sample: &Sample, group: &[usize], template: &[[f64; 3]], frames: &[us
     fits
 }
 
-/// Mean head-coordinate position of each other marker.
-fn head_means(sample: &Sample, fits: &Fits, others: &[usize]) -> Vec<Vector3<f64>> {
-    // Markers at once on the current rayon pool, collected in order.
-    others
-        .par_iter()
-        .filter_map(|&m| {
-            let (mut sum, mut count) = (Vector3::zeros(), 0usize);
-            for (&f, pose) in fits.frames.iter().zip(&fits.poses) {
-                if let Some(p) = sample.get(f, m) {
-                    sum += pose.rotation.transpose() * (point(p, 0) - pose.translation);
-                    count += 1;
-                }
-            }
-            (count > 0).then(|| sum / count as f64)
-        })
-        .collect()
-}
-
 /// Fitzpatrick's TRE averaged (RMS) over `targets`, for a group of the template's shape.
 fn tre(template: &[[f64; 3]], targets: &[Vector3<f64>], fle: f64) -> f64 {
     if targets.is_empty() {
@@ -332,14 +313,14 @@ fn pose_params(p: &Pose) -> SVector<f64, 6> {
     ])
 }
 
-/// Median over `others` of the share of their head-coordinate variance explained linearly by
-/// the pose parameters.
-fn leakage(sample: &Sample, fits: &Fits, others: &[usize]) -> f64 {
+/// The other markers in the group's coordinates, each in one pass over its frames: the mean
+/// head-coordinate position of each (that has any), and the leakage, the median over them of
+/// the share of their head-coordinate variance explained linearly by the pose parameters.
+/// Markers at once on the current rayon pool (a shortlist of a few groups would keep one core
+/// busy and the other idle), each into its own buffer of rows, collected in order.
+fn seen_from_head(sample: &Sample, fits: &Fits, others: &[usize]) -> (Vec<Vector3<f64>>, f64) {
     let params: Vec<SVector<f64, 6>> = fits.poses.iter().map(pose_params).collect();
-    // Markers at once on the current rayon pool (a shortlist of a few groups would keep one
-    // core busy and the other idle), each into its own buffer of rows; the median does not
-    // depend on the order.
-    let mut shares: Vec<f64> = others
+    let each: Vec<(Option<Vector3<f64>>, Option<f64>)> = others
         .par_iter()
         .map_init(Vec::new, |rows, &m| {
             rows.clear();
@@ -350,11 +331,14 @@ fn leakage(sample: &Sample, fits: &Fits, others: &[usize]) -> f64 {
                     Some((p.push(1.0), head))
                 },
             ));
-            explained_share(rows)
+            let mean = (!rows.is_empty())
+                .then(|| rows.iter().map(|r| r.1).sum::<Vector3<f64>>() / rows.len() as f64);
+            (mean, explained_share(rows))
         })
-        .flatten()
         .collect();
-    median(&mut shares)
+    let targets = each.iter().filter_map(|e| e.0).collect();
+    let mut shares: Vec<f64> = each.iter().filter_map(|e| e.1).collect();
+    (targets, median(&mut shares))
 }
 
 /// Share of the variance of `y` explained by a least-squares fit on `x` (with intercept).
