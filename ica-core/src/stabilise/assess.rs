@@ -15,6 +15,7 @@
 //!   (high).
 
 use nalgebra::{Matrix3, SMatrix, SVector, SymmetricEigen, Vector3};
+use rayon::prelude::*;
 
 use super::sample::Sample;
 use super::{centre, kabsch, point, Pose};
@@ -120,10 +121,9 @@ pub(crate) fn assess_group(
     res.truncate(((res.len() as f64 * 0.99).ceil() as usize).max(1));
     let fre_sq = res.iter().sum::<f64>() / res.len() as f64;
     let deformation_mm = (fre_sq / (1.0 - 2.0 / k as f64).max(1.0 / 3.0)).sqrt();
-    let targets = head_means(sample, &fits, &others);
+    let (targets, leakage) = seen_from_head(sample, &fits, &others);
     let pose_error_mm = tre(&template, &targets, deformation_mm);
     let motion_mm = motion(&fits, &targets);
-    let leakage = leakage(sample, &fits, &others);
     Some(GroupAssessment {
         markers: group.to_vec(),
         marker_residual_mm,
@@ -148,12 +148,14 @@ fn template(sample: &Sample, group: &[usize], frames: &[usize]) -> Option<Vec<[f
     centre(&mut template);
     let mut sum = vec![Vector3::<f64>::zeros(); group.len()];
     let mut count = vec![0usize; group.len()];
-    let mut pairs = Pairs::with_capacity(group.len());
     for _ in 0..3 {
         sum.fill(Vector3::zeros());
         count.fill(0);
-        for &f in frames {
-            let Some(pose) = fit(sample, group, &template, f, &mut pairs) else {
+        for (&f, pose) in frames
+            .iter()
+            .zip(fit_each(sample, group, &template, frames))
+        {
+            let Some(pose) = pose else {
                 continue;
             };
             let inv = pose.rotation.transpose();
@@ -195,6 +197,25 @@ fn fit(
     kabsch(pairs.iter().map(|(t, q)| (t, *q))).map(|(pose, _)| pose)
 }
 
+/// The group's pose in each of `frames` (`None` where it cannot be fitted), frames at once on
+/// the current rayon pool: the fits are most of an assessment, and a shortlist of a few groups
+/// assessed at once would leave a core idle. Collected in order, so what the caller sums over
+/// them is summed in the same order whatever the thread count.
+fn fit_each(
+    sample: &Sample,
+    group: &[usize],
+    template: &[[f64; 3]],
+    frames: &[usize],
+) -> Vec<Option<Pose>> {
+    frames
+        .par_iter()
+        .map_init(
+            || Pairs::with_capacity(group.len()),
+            |pairs, &f| fit(sample, group, template, f, pairs),
+        )
+        .collect()
+}
+
 /// Poses and residuals of the group in every one of `frames` where it can be fitted.
 fn fit_all(sample: &Sample, group: &[usize], template: &[[f64; 3]], frames: &[usize]) -> Fits {
     let mut fits = Fits {
@@ -203,9 +224,8 @@ fn fit_all(sample: &Sample, group: &[usize], template: &[[f64; 3]], frames: &[us
         residual_sq: Vec::with_capacity(frames.len()),
         per_marker_sq: Vec::with_capacity(frames.len() * group.len()),
     };
-    let mut pairs = Pairs::with_capacity(group.len());
-    for &f in frames {
-        let Some(pose) = fit(sample, group, template, f, &mut pairs) else {
+    for (&f, pose) in frames.iter().zip(fit_each(sample, group, template, frames)) {
+        let Some(pose) = pose else {
             continue;
         };
         let (mut sq, mut used) = (0.0, 0usize);
@@ -226,23 +246,6 @@ fn fit_all(sample: &Sample, group: &[usize], template: &[[f64; 3]], frames: &[us
         fits.residual_sq.push(sq / used as f64);
     }
     fits
-}
-
-/// Mean head-coordinate position of each other marker.
-fn head_means(sample: &Sample, fits: &Fits, others: &[usize]) -> Vec<Vector3<f64>> {
-    others
-        .iter()
-        .filter_map(|&m| {
-            let (mut sum, mut count) = (Vector3::zeros(), 0usize);
-            for (&f, pose) in fits.frames.iter().zip(&fits.poses) {
-                if let Some(p) = sample.get(f, m) {
-                    sum += pose.rotation.transpose() * (point(p, 0) - pose.translation);
-                    count += 1;
-                }
-            }
-            (count > 0).then(|| sum / count as f64)
-        })
-        .collect()
 }
 
 /// Fitzpatrick's TRE averaged (RMS) over `targets`, for a group of the template's shape.
@@ -310,14 +313,16 @@ fn pose_params(p: &Pose) -> SVector<f64, 6> {
     ])
 }
 
-/// Median over `others` of the share of their head-coordinate variance explained linearly by
-/// the pose parameters.
-fn leakage(sample: &Sample, fits: &Fits, others: &[usize]) -> f64 {
+/// The other markers in the group's coordinates, each in one pass over its frames: the mean
+/// head-coordinate position of each (that has any), and the leakage, the median over them of
+/// the share of their head-coordinate variance explained linearly by the pose parameters.
+/// Markers at once on the current rayon pool (a shortlist of a few groups would keep one core
+/// busy and the other idle), each into its own buffer of rows, collected in order.
+fn seen_from_head(sample: &Sample, fits: &Fits, others: &[usize]) -> (Vec<Vector3<f64>>, f64) {
     let params: Vec<SVector<f64, 6>> = fits.poses.iter().map(pose_params).collect();
-    let mut rows = Vec::with_capacity(params.len());
-    let mut shares: Vec<f64> = others
-        .iter()
-        .filter_map(|&m| {
+    let each: Vec<(Option<Vector3<f64>>, Option<f64>)> = others
+        .par_iter()
+        .map_init(Vec::new, |rows, &m| {
             rows.clear();
             rows.extend(fits.frames.iter().zip(&fits.poses).zip(&params).filter_map(
                 |((&f, pose), p)| {
@@ -326,10 +331,14 @@ fn leakage(sample: &Sample, fits: &Fits, others: &[usize]) -> f64 {
                     Some((p.push(1.0), head))
                 },
             ));
-            explained_share(&rows)
+            let mean = (!rows.is_empty())
+                .then(|| rows.iter().map(|r| r.1).sum::<Vector3<f64>>() / rows.len() as f64);
+            (mean, explained_share(rows))
         })
         .collect();
-    median(&mut shares)
+    let targets = each.iter().filter_map(|e| e.0).collect();
+    let mut shares: Vec<f64> = each.iter().filter_map(|e| e.1).collect();
+    (targets, median(&mut shares))
 }
 
 /// Share of the variance of `y` explained by a least-squares fit on `x` (with intercept).

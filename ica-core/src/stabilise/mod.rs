@@ -24,7 +24,7 @@ pub mod search;
 mod transform;
 
 pub use assess::{GroupAssessment, MIN_MOTION_MM, MOTION_FACTOR};
-pub use sample::MarkerFrames;
+pub use sample::{MarkerFrames, TakeFrames};
 pub use search::{assess_named, choose, search_reference, Choice, ReferenceSearch, SearchParams};
 pub use transform::{to_head_into, to_world_into};
 

@@ -2,22 +2,26 @@
 //! bounded sample of them with neighbours and glitches masked ([`Sample`]), and the robust
 //! statistics both the search and the assessment use.
 
-use std::ops::Range;
-
 use crate::robust::{mad, median, quantile_f32};
 
-/// Frames of a capture in one marker order: `xyz` frames x markers x 3 (mm), `missing` frames
-/// x markers, and the frame range of each take (differences never cross a take boundary).
+/// Frames of a capture in one marker order, take by take (differences never cross a take
+/// boundary). The takes are borrowed where they lie, so a caller holding them apart need not
+/// join them.
 #[derive(Debug, Clone, Copy)]
 pub struct MarkerFrames<'a> {
+    /// Each take's frames.
+    pub takes: &'a [TakeFrames<'a>],
+    /// Markers per frame.
+    pub markers: usize,
+}
+
+/// One take's frames (or one stretch of a take) in [`MarkerFrames`]' marker order.
+#[derive(Debug, Clone, Copy)]
+pub struct TakeFrames<'a> {
     /// Positions, frames x markers x 3 (mm).
     pub xyz: &'a [f32],
     /// Missing flags, frames x markers.
     pub missing: &'a [bool],
-    /// Markers per frame.
-    pub markers: usize,
-    /// Frame range of each take.
-    pub takes: &'a [Range<usize>],
 }
 
 /// Sampled frames, each with its two neighbours, glitches masked.
@@ -42,22 +46,23 @@ const MIN_GLITCH_STEP_MM: f64 = 4.0;
 impl Sample {
     pub(crate) fn draw(frames: &MarkerFrames<'_>, max_frames: usize) -> Sample {
         let n = frames.markers;
-        let inner: usize = frames.takes.iter().map(|r| r.len().saturating_sub(2)).sum();
+        let lengths: Vec<usize> = (frames.takes.iter())
+            .map(|t| t.missing.len() / n.max(1))
+            .collect();
+        let inner: usize = lengths.iter().map(|l| l.saturating_sub(2)).sum();
         let stride = (inner / max_frames.max(1)).max(1);
         let sampled = inner / stride;
         let mut xyz = Vec::with_capacity(sampled * 3 * n * 3);
         let mut present = Vec::with_capacity(sampled * 3 * n);
         let mut k = 0usize;
-        for take in frames.takes {
-            for f in take.start + 1..take.end.saturating_sub(1) {
+        for (take, &len) in frames.takes.iter().zip(&lengths) {
+            for f in 1..len.saturating_sub(1) {
                 k += 1;
                 if k % stride != 0 {
                     continue;
                 }
-                for g in f - 1..=f + 1 {
-                    xyz.extend_from_slice(&frames.xyz[g * n * 3..(g + 1) * n * 3]);
-                    present.extend(frames.missing[g * n..(g + 1) * n].iter().map(|m| !m));
-                }
+                xyz.extend_from_slice(&take.xyz[(f - 1) * n * 3..(f + 2) * n * 3]);
+                present.extend(take.missing[(f - 1) * n..(f + 2) * n].iter().map(|m| !m));
             }
         }
         let mut sample = Sample {
@@ -72,11 +77,14 @@ impl Sample {
         sample
     }
 
-    /// [`Sample::columns`] from the frame-major storage, written column by column.
+    /// [`Sample::columns`] from the frame-major storage, written column by column, columns at
+    /// once on the current rayon pool.
     fn transposed(&self) -> Vec<f32> {
+        use rayon::prelude::*;
         let (n, t) = (self.markers, self.present.len() / self.markers.max(1));
         let mut columns = vec![0.0; n * 3 * t];
-        for (c, column) in columns.chunks_exact_mut(t.max(1)).enumerate() {
+        let columns_of = columns.par_chunks_exact_mut(t.max(1)).enumerate();
+        columns_of.for_each(|(c, column)| {
             let (m, axis) = (c / 3, c % 3);
             for (f, v) in column.iter_mut().enumerate() {
                 let i = f * n + m;
@@ -86,7 +94,7 @@ impl Sample {
                     f32::NAN
                 };
             }
-        }
+        });
         columns
     }
 

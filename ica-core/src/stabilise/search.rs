@@ -144,15 +144,17 @@ pub fn search_reference(frames: &MarkerFrames<'_>, params: &SearchParams) -> Ref
     // Grown at the strain limit and at a half and a quarter of it: a marker that barely moves
     // relative to a band (or moves across the lines to it, which distances hardly see) joins
     // the band at the loose limit but not at the tight ones.
+    let sorted = pairs.sorted_pairs();
     let mut groups = Vec::new();
     for divisor in [4.0, 2.0, 1.0] {
-        for g in rigid_groups(&pairs, params.rigid_strain / divisor, params.max_groups) {
+        let limit = params.rigid_strain / divisor;
+        for g in rigid_groups(&pairs, &sorted, limit, params.max_groups) {
             if !groups.contains(&g) {
                 groups.push(g);
             }
         }
     }
-    let ld = least_deforming(&pairs, params.least_deforming);
+    let ld = least_deforming(&pairs, &sorted, params.least_deforming);
     if ld.len() >= 3 && !groups.contains(&ld) {
         groups.push(ld);
     }
@@ -294,13 +296,19 @@ pub fn assess_named(frames: &MarkerFrames<'_>, markers: &[usize]) -> Option<Grou
     assess_group(&sample, markers, &scope, noise_mm)
 }
 
-/// Maximal groups within `limit`, each grown from one of the most rigid pairs by
-/// adding the marker closest (in mean strain) to the group while every pair stays rigid.
-fn rigid_groups(pairs: &PairTable, limit: f64, max_groups: usize) -> Vec<Vec<usize>> {
+/// Maximal groups within `limit`, each grown from one of the most rigid pairs (`sorted`: the
+/// pairs by increasing strain) by adding the marker closest (in mean strain) to the group
+/// while every pair stays rigid.
+fn rigid_groups(
+    pairs: &PairTable,
+    sorted: &[(usize, usize)],
+    limit: f64,
+    max_groups: usize,
+) -> Vec<Vec<usize>> {
     let mut groups: Vec<Vec<usize>> = Vec::new();
-    let seeds = pairs
-        .sorted_pairs()
-        .into_iter()
+    let seeds = sorted
+        .iter()
+        .copied()
         .take_while(|&(i, j)| pairs.strain(i, j) <= limit)
         .take(max_groups);
     for (i, j) in seeds {
@@ -328,9 +336,9 @@ fn rigid_groups(pairs: &PairTable, limit: f64, max_groups: usize) -> Vec<Vec<usi
 }
 
 /// The `count` markers grown greedily from the most rigid pair by least mean strain, whatever
-/// the strain: the fallback when nothing is rigid.
-fn least_deforming(pairs: &PairTable, count: usize) -> Vec<usize> {
-    let Some(&(i, j)) = pairs.sorted_pairs().first() else {
+/// the strain (`sorted`: the pairs by increasing strain): the fallback when nothing is rigid.
+fn least_deforming(pairs: &PairTable, sorted: &[(usize, usize)], count: usize) -> Vec<usize> {
+    let Some(&(i, j)) = sorted.first() else {
         return Vec::new();
     };
     let mut group = vec![i, j];

@@ -7,7 +7,7 @@
 use anyhow::Result;
 use ica_core::model::CaptureSettings;
 use ica_core::quality::HeadReport;
-use ica_core::stabilise::{HeadReference, MarkerFrames, Stabiliser};
+use ica_core::stabilise::{HeadReference, MarkerFrames, Stabiliser, TakeFrames};
 
 use super::glitches::{auto_speed, marker_bounds};
 use super::{head, run_prep, PrepOptions, SpeedLimit};
@@ -75,13 +75,16 @@ pub(super) fn decide_head(
     excluded: &[(String, f64)],
     options: &PrepOptions,
 ) -> Result<DecidedHead> {
-    let n = labels.len();
-    let (raw_xyz, raw_missing, ranges) = concatenated(frames, n);
+    // The takes as they lie: the search reads a bounded sample of their frames.
+    let takes: Vec<TakeFrames<'_>> = (frames.iter())
+        .map(|f| TakeFrames {
+            xyz: &f.xyz,
+            missing: &f.missing,
+        })
+        .collect();
     let raw = MarkerFrames {
-        xyz: &raw_xyz,
-        missing: &raw_missing,
-        markers: n,
-        takes: &ranges,
+        takes: &takes,
+        markers: labels.len(),
     };
     let decision = head::decide(&options.head, labels, excluded, &raw)?;
     let reference = decision.markers;
@@ -147,30 +150,6 @@ pub(super) fn learn_limits(
         residuals,
     };
     Ok((learned, frames))
-}
-
-/// The sample's frames end to end (`n` markers each): positions, missing flags, and each
-/// stretch's range of frames.
-fn concatenated(
-    frames: &[ModelFrames],
-    n: usize,
-) -> (Vec<f32>, Vec<bool>, Vec<std::ops::Range<usize>>) {
-    let held: usize = frames.iter().map(ModelFrames::frames).sum();
-    let (mut raw_xyz, mut raw_missing) = (
-        Vec::with_capacity(held * n * 3),
-        Vec::with_capacity(held * n),
-    );
-    for f in frames {
-        raw_xyz.extend_from_slice(&f.xyz);
-        raw_missing.extend_from_slice(&f.missing);
-    }
-    let mut ranges = Vec::with_capacity(frames.len());
-    let mut start = 0;
-    for f in frames {
-        ranges.push(start..start + f.frames());
-        start += f.frames();
-    }
-    (raw_xyz, raw_missing, ranges)
 }
 
 /// RMS distance (mm) of each reference marker from its template place, over prepared

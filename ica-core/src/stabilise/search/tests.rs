@@ -1,4 +1,5 @@
 use super::*;
+use crate::stabilise::TakeFrames;
 use nalgebra::{Rotation3, Vector3};
 
 /// A head band (4 markers), a jaw (4 markers rotating about a hinge with "speech"), and 6
@@ -79,15 +80,13 @@ fn scene(frames: usize, head: bool) -> (Vec<f32>, Vec<bool>) {
 
 fn decide(head: bool) -> Choice {
     let (xyz, missing) = scene(3000, head);
-    let takes = vec![std::ops::Range {
-        start: 0,
-        end: 3000,
-    }];
-    let frames = MarkerFrames {
+    let takes = [TakeFrames {
         xyz: &xyz,
         missing: &missing,
-        markers: 14,
+    }];
+    let frames = MarkerFrames {
         takes: &takes,
+        markers: 14,
     };
     let found = search_reference(&frames, &SearchParams::default());
     choose(&found.candidates)
