@@ -30,6 +30,32 @@ const TILE_FRAMES: usize = 128;
 /// Vectors of accumulators in one tile of a row (the rest of 16 registers: broadcasts, loads).
 const TILE: usize = 6;
 
+/// Runs `$call` once per tile of at most [`TILE`] of the `$kv` vectors, with `$v0` the tile's
+/// first vector and `$t` its width as a constant (so the accumulators are a fixed-size array).
+macro_rules! for_each_tile {
+    ($kv:expr, $v0:ident, $t:ident => $call:expr) => {{
+        let kv = $kv;
+        let mut $v0 = 0;
+        while $v0 < kv {
+            let width = (kv - $v0).min(TILE);
+            for_each_tile!(@widths width, $t => $call; 1 2 3 4 5);
+            $v0 += width;
+        }
+    }};
+    (@widths $width:ident, $t:ident => $call:expr; $($n:literal)*) => {
+        match $width {
+            $($n => {
+                const $t: usize = $n;
+                $call
+            })*
+            _ => {
+                const $t: usize = TILE;
+                $call
+            }
+        }
+    };
+}
+
 /// The rotation in this kernel's layout and the sums so far (see the module docs).
 #[derive(Debug, Clone)]
 pub(crate) struct Fused {
@@ -165,10 +191,10 @@ impl pulp::WithSimd for Tile<'_> {
         let mut j = 0;
         while j < m {
             if m - j >= 2 {
-                outer_rows::<2>(v3, z, m, j, g, kv, bt);
+                for_each_tile!(kv, v0, T => outer_tile::<2, T>(v3, z, m, j, g, kv, v0, bt));
                 j += 2;
             } else {
-                outer_rows::<1>(v3, z, m, j, g, kv, bt);
+                for_each_tile!(kv, v0, T => outer_tile::<1, T>(v3, z, m, j, g, kv, v0, bt));
                 j += 1;
             }
         }
@@ -185,19 +211,7 @@ fn sources<const F: usize>(
     zt: &[f64],
     y: &mut [[f64; 4]],
 ) {
-    let mut v0 = 0;
-    while v0 < kv {
-        let t = (kv - v0).min(TILE);
-        match t {
-            1 => sources_tile::<F, 1>(v3, wt, kv, v0, m, zt, y),
-            2 => sources_tile::<F, 2>(v3, wt, kv, v0, m, zt, y),
-            3 => sources_tile::<F, 3>(v3, wt, kv, v0, m, zt, y),
-            4 => sources_tile::<F, 4>(v3, wt, kv, v0, m, zt, y),
-            5 => sources_tile::<F, 5>(v3, wt, kv, v0, m, zt, y),
-            _ => sources_tile::<F, TILE>(v3, wt, kv, v0, m, zt, y),
-        }
-        v0 += t;
-    }
+    for_each_tile!(kv, v0, T => sources_tile::<F, T>(v3, wt, kv, v0, m, zt, y));
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -269,33 +283,8 @@ fn tanh_f32x4(v3: V3, x: pulp::f32x4) -> pulp::f32x4 {
     v3.div_f32x4(v3.mul_f32x4(x, p), q)
 }
 
-/// `B`'s rows `j..j + R` plus `Σ_t z_t[j + r] g_t` over the tile's frames, `TILE` vectors at a
-/// time.
-#[inline(always)]
-fn outer_rows<const R: usize>(
-    v3: V3,
-    z: &[f64],
-    m: usize,
-    j: usize,
-    g: &[[f64; 4]],
-    kv: usize,
-    bt: &mut [[f64; 4]],
-) {
-    let mut v0 = 0;
-    while v0 < kv {
-        let t = (kv - v0).min(TILE);
-        match t {
-            1 => outer_tile::<R, 1>(v3, z, m, j, g, kv, v0, bt),
-            2 => outer_tile::<R, 2>(v3, z, m, j, g, kv, v0, bt),
-            3 => outer_tile::<R, 3>(v3, z, m, j, g, kv, v0, bt),
-            4 => outer_tile::<R, 4>(v3, z, m, j, g, kv, v0, bt),
-            5 => outer_tile::<R, 5>(v3, z, m, j, g, kv, v0, bt),
-            _ => outer_tile::<R, TILE>(v3, z, m, j, g, kv, v0, bt),
-        }
-        v0 += t;
-    }
-}
-
+/// `B`'s rows `j..j + R` plus `Σ_t z_t[j + r] g_t` over the tile's frames, for the `T` vectors
+/// from `v0`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn outer_tile<const R: usize, const T: usize>(
