@@ -126,7 +126,7 @@ impl<R: BufRead> NextRow for CsvRows<R> {
             return Ok(None);
         };
         let width = 2 + self.extra + xyz.len();
-        let cells: Vec<&str> = row.split(',').collect();
+        let cells = text::split_cells(row, b',', width);
         if cells.len() != width {
             let found = cells.len();
             return Err(ReadError::ColumnCount {

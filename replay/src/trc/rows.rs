@@ -131,8 +131,8 @@ impl RowParser {
         xyz: &mut [f32],
         gone: &mut [bool],
     ) -> Result<i64, ReadError> {
-        let cells: Vec<&str> = text.split('\t').collect();
         let width = 2 + 3 * self.labels.len();
+        let cells = text::split_cells(text, b'\t', width);
         if cells.len() < 2 {
             return Err(ReadError::ColumnCount {
                 line,

@@ -132,7 +132,7 @@ pub(crate) const EXPECTED_SAMPLE: &str = "a finite number, an empty cell or NaN"
 /// # Errors
 /// The text to report for a non-numeric or infinite cell (the caller knows line and column).
 pub(crate) fn parse_sample(cell: &str) -> Result<Sample, &'static str> {
-    let cell = cell.trim();
+    let cell = trim(cell);
     if cell.is_empty() {
         return Ok(Sample::Missing);
     }
@@ -141,6 +141,37 @@ pub(crate) fn parse_sample(cell: &str) -> Result<Sample, &'static str> {
         Ok(v) if v.is_finite() => Ok(Sample::Value(v)),
         _ => Err(EXPECTED_SAMPLE),
     }
+}
+
+/// `cell.trim()`, in the common case (ASCII at both ends once ASCII whitespace is gone) without
+/// decoding characters: `str::trim` also removes Unicode whitespace (U+000B and U+00A0 among
+/// them), so any other end takes std's path.
+fn trim(cell: &str) -> &str {
+    let t = cell.trim_ascii();
+    let plain = |b: Option<&u8>| b.is_none_or(|&b| b.is_ascii() && b != 0x0b);
+    if plain(t.as_bytes().first()) && plain(t.as_bytes().last()) {
+        t
+    } else {
+        cell.trim()
+    }
+}
+
+/// The cells of a row separated by `sep` (an ASCII byte), as `row.split(sep)` gives them, in
+/// one SIMD pass over the row: std's `split` sets out afresh for each separator, which took as
+/// long as parsing the numbers. `width` is the number of cells expected (room reserved).
+pub(crate) fn split_cells(row: &str, sep: u8, width: usize) -> Vec<&str> {
+    debug_assert!(
+        sep.is_ascii(),
+        "a separator inside a character would split it"
+    );
+    let mut cells = Vec::with_capacity(width);
+    let mut start = 0;
+    for end in memchr::memchr_iter(sep, row.as_bytes()) {
+        cells.push(&row[start..end]);
+        start = end + 1;
+    }
+    cells.push(&row[start..]);
+    cells
 }
 
 /// Parses a frame number: an integer, or a number with no fractional part (`12.0`), which some

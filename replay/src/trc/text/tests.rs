@@ -1,4 +1,44 @@
 use super::*;
+use proptest::prelude::*;
+
+/// Cells made of the characters a row's splitting and trimming must get right: separators,
+/// ASCII and Unicode whitespace (U+000B is whitespace to `str::trim` and not to
+/// `trim_ascii`), digits and a multi-byte letter.
+fn row_text() -> impl Strategy<Value = String> {
+    let pieces = prop::sample::select(vec![
+        "\t", ",", " ", "\u{b}", "\u{a0}", "\u{3000}", "\r", "1", "-2.5", "e3", "NaN", "é", "",
+    ]);
+    prop::collection::vec(pieces, 0..24).prop_map(|p| p.concat())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2_000))]
+
+    #[test]
+    fn cells_split_and_trim_as_std_does(row in row_text()) {
+        for sep in [b'\t', b','] {
+            let ours = split_cells(&row, sep, 4);
+            let std: Vec<&str> = row.split(char::from(sep)).collect();
+            prop_assert_eq!(&ours, &std);
+            for cell in ours {
+                prop_assert_eq!(trim(cell), cell.trim());
+                prop_assert_eq!(parse_sample(cell), parse_sample_std(cell));
+            }
+        }
+    }
+}
+
+/// [`parse_sample`] as it was written with std's `trim`.
+fn parse_sample_std(cell: &str) -> Result<Sample, &'static str> {
+    match cell.trim() {
+        "" => Ok(Sample::Missing),
+        t => match t.parse::<f64>() {
+            Ok(v) if v.is_nan() => Ok(Sample::Missing),
+            Ok(v) if v.is_finite() => Ok(Sample::Value(v)),
+            _ => Err(EXPECTED_SAMPLE),
+        },
+    }
+}
 
 #[test]
 fn samples_blank_nan_number_and_rejects() {
