@@ -289,67 +289,67 @@ impl pulp::WithSimd for Resynth<'_> {
 
 /// `out = mean + Q y` for the block-interleaved groups of `H` columns in `mixing` (`y` read
 /// as zero past its end, as the padding columns are): per block of 8 channels, the mean
-/// (first group) or `out`, `H` multiply-adds, one store; the last, partial block through a
-/// local vector.
+/// (first group) or `out`, `H` multiply-adds, one store ([`sum_blocks`]).
 #[inline(always)]
 fn resynth<const H: usize>(v3: V3, mixing: &[f32], u: &[f32], mean: &[f32], out: &mut [f32]) {
     let (means, _) = as_arrays::<8, f32>(mean);
     let (mixing, _) = as_arrays::<8, f32>(mixing);
     let blocks = means.len();
     let full = out.len() / 8;
-    let zero = v3.splat_f32x8(0.0);
     for (g, group) in mixing.chunks_exact(blocks * H).enumerate() {
         let a: [f32x8; H] =
             std::array::from_fn(|i| v3.splat_f32x8(u.get(g * H + i).copied().unwrap_or(0.0)));
         let (outs, tail) = pulp::as_arrays_mut::<8, f32>(out);
-        // Four blocks at a time, their sums' chains interleaved: each block's chain of `H`
-        // dependent multiply-adds alone would leave the FMA pipes waiting on its latency
-        // (Zen 1 splits each 256-bit operation in two and holds fewer in flight). Each
-        // block's sum is still taken in the same order, so the result is the same to the bit.
+        // Four blocks at a time, then one (see `sum_blocks`).
         let quads = full / 4 * 4;
         let (cols4, cols1) = group[..full * H].split_at(quads * H);
         let (outs4, outs1) = outs.split_at_mut(quads);
         let (means4, means1) = means.split_at(quads);
-        for ((cols, o), m) in cols4
-            .chunks_exact(4 * H)
-            .zip(outs4.chunks_exact_mut(4))
-            .zip(means4.chunks_exact(4))
-        {
-            let mut s = [zero; 4];
-            for i in 0..H {
-                for (j, s) in s.iter_mut().enumerate() {
-                    *s = v3.mul_add_f32x8(a[i], cast(cols[j * H + i]), *s);
-                }
-            }
-            for j in 0..4 {
-                o[j] = cast(v3.add_f32x8(cast(if g == 0 { m[j] } else { o[j] }), s[j]));
-            }
-        }
-        for ((cols, o), m) in cols1.chunks_exact(H).zip(outs1.iter_mut()).zip(means1) {
-            // The group's sum first, then onto the mean or `out` (coordinates of a metre or
-            // so): one rounding at their scale per group, not one per column.
-            let mut s = zero;
-            for i in 0..H {
-                s = v3.mul_add_f32x8(a[i], cast(cols[i]), s);
-            }
-            *o = cast(v3.add_f32x8(cast(if g == 0 { *m } else { *o }), s));
-        }
+        let base = |means| if g == 0 { Some(means) } else { None };
+        sum_blocks::<H, 4>(v3, &a, cols4, outs4, base(means4));
+        sum_blocks::<H, 1>(v3, &a, cols1, outs1, base(means1));
         if !tail.is_empty() {
+            // The last, partial block through a local one.
+            let mut last = [[0.0f32; 8]];
+            last[0][..tail.len()].copy_from_slice(tail);
             let cols = &group[full * H..(full + 1) * H];
-            let base: [f32; 8] = if g == 0 {
-                means[full]
-            } else {
-                let mut b = [0.0; 8];
-                b[..tail.len()].copy_from_slice(tail);
-                b
-            };
-            let mut s = zero;
-            for i in 0..H {
-                s = v3.mul_add_f32x8(a[i], cast(cols[i]), s);
-            }
-            let s: [f32; 8] = cast(v3.add_f32x8(cast(base), s));
+            sum_blocks::<H, 1>(v3, &a, cols, &mut last, base(&means[full..full + 1]));
             let len = tail.len();
-            tail.copy_from_slice(&s[..len]);
+            tail.copy_from_slice(&last[0][..len]);
+        }
+    }
+}
+
+/// `out = base + Σ_i a_i cols_i` for whole blocks of 8 channels (`cols`: each block's `H`
+/// columns in turn), `B` blocks at a time with their sums' chains interleaved: one block's
+/// chain of `H` dependent multiply-adds alone leaves the FMA pipes waiting on its latency
+/// (Zen 1 splits each 256-bit operation in two and holds fewer in flight). Each block's sum is
+/// taken in the same order whatever `B`, so the result is the same to the bit. The group's sum
+/// comes first, then onto the mean (`base`, the first group) or `out` (coordinates of a metre or
+/// so): one rounding at their scale per group, not one per column.
+#[inline(always)]
+fn sum_blocks<const H: usize, const B: usize>(
+    v3: V3,
+    a: &[f32x8; H],
+    cols: &[[f32; 8]],
+    outs: &mut [[f32; 8]],
+    base: Option<&[[f32; 8]]>,
+) {
+    let zero = v3.splat_f32x8(0.0);
+    for (k, (cols, o)) in cols
+        .chunks_exact(B * H)
+        .zip(outs.chunks_exact_mut(B))
+        .enumerate()
+    {
+        let mut s = [zero; B];
+        for i in 0..H {
+            for (j, s) in s.iter_mut().enumerate() {
+                *s = v3.mul_add_f32x8(a[i], cast(cols[j * H + i]), *s);
+            }
+        }
+        for j in 0..B {
+            let onto = base.map_or(o[j], |m| m[k * B + j]);
+            o[j] = cast(v3.add_f32x8(cast(onto), s[j]));
         }
     }
 }

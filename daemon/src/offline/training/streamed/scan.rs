@@ -109,20 +109,14 @@ pub(super) fn scan(
     let first_labels = first.labels.clone();
     let sizes = file_sizes(takes);
     let (hold, sample_guess) = session_guess(takes, &sizes, &first, rate_hz, hold_frames);
-    // Read once: the first batch takes it rather than reading the file again (a quarter of
-    // the reading when a session is four takes).
-    let first = std::sync::Mutex::new(Some(first));
+    let first = FirstTake(std::sync::Mutex::new(Some(first)));
     let mut counts = MissingCounts::new(first_labels.clone());
     let mut sampler = Sampler::new(sample_frames, sample_guess);
     let mut scan = Scan::new(rate_hz, takes.len(), first_labels.len(), hold);
     let mut bytes = Vec::new();
     let mut raw = Spill::new(first_labels.len() * 13)?;
     let load = |i: usize| {
-        let read = (i == 0).then(|| first.lock().ok()?.take()).flatten();
-        let take = match read {
-            Some(take) => take,
-            None => takes[i].load(super::DECODING)?,
-        };
+        let take = first.take_or_load(i, takes)?;
         let at_rate = at_rate(&take, rate_hz);
         Ok((take, at_rate))
     };
@@ -159,6 +153,21 @@ pub(super) fn scan(
     scan.labels = labels;
     scan.excluded = excluded;
     Ok(scan)
+}
+
+/// The first take, read once to learn the session's labels and rate: the first batch takes it
+/// rather than reading the file again (a quarter of the reading when a session is four takes).
+struct FirstTake(std::sync::Mutex<Option<replay::Take>>);
+
+impl FirstTake {
+    /// Take `i` of `takes`: the one held for the first, read for the others.
+    fn take_or_load(&self, i: usize, takes: &[TakeInput]) -> Result<replay::Take> {
+        let held = (i == 0).then(|| self.0.lock().ok()?.take()).flatten();
+        match held {
+            Some(take) => Ok(take),
+            None => takes[i].load(super::DECODING),
+        }
+    }
 }
 
 /// Each file's size in bytes (1 when it cannot be read: the reading will say why).
