@@ -158,13 +158,15 @@ fn trim(cell: &str) -> &str {
 
 /// The cells of a row separated by `sep` (an ASCII byte), as `row.split(sep)` gives them, in
 /// one SIMD pass over the row: std's `split` sets out afresh for each separator, which took as
-/// long as parsing the numbers. `width` is the number of cells expected (room reserved).
+/// long as parsing the numbers. `width` is the number of cells expected: room is reserved for
+/// it, but never for more cells than the row can hold (a header naming a million markers does
+/// not make each short row allocate for a million).
 pub(crate) fn split_cells(row: &str, sep: u8, width: usize) -> Vec<&str> {
     debug_assert!(
         sep.is_ascii(),
         "a separator inside a character would split it"
     );
-    let mut cells = Vec::with_capacity(width);
+    let mut cells = Vec::with_capacity(width.min(row.len() + 1));
     let mut start = 0;
     for end in memchr::memchr_iter(sep, row.as_bytes()) {
         cells.push(&row[start..end]);
