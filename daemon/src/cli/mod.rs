@@ -7,16 +7,17 @@ use clap::{Args, Parser, Subcommand};
 mod live;
 mod offline;
 mod range;
+mod sessions;
 mod values;
 
 pub use live::{
     BenchArgs, DemoArgs, NatNetArgs, RecordArgs, ReplayArgs, ServeArgs, SessionArgs, WireFormat,
 };
 pub use offline::{
-    AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InjectArgs, InspectArgs, KeyValue, ProjectArgs,
-    SynthArgs, TrainArgs,
+    AnalyzeArgs, ConvertArgs, EditArgs, InfoArgs, InspectArgs, KeyValue, ProjectArgs, TrainArgs,
 };
 pub use range::RangeArgs;
+pub use sessions::{InjectArgs, SynthArgs};
 
 /// A command-line error on one line, as every other failure is: clap's message with its
 /// indented details joined on, then where to look.
