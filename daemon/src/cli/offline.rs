@@ -196,6 +196,10 @@ pub struct EditArgs {
     /// Frames read and edited at a time (tests and measurements).
     #[arg(long, hide = true, default_value_t = crate::offline::streamed::BLOCK_FRAMES)]
     pub block_frames: usize,
+    /// MiB of `--to-emotion`'s first pass kept for the edit, which then does not prepare and
+    /// project those frames again (tests and measurements; 0 keeps none).
+    #[arg(long, hide = true, default_value_t = crate::offline::streamed::KEEP_BYTES >> 20)]
+    pub keep_mb: usize,
 }
 
 /// `emoshift inspect`.

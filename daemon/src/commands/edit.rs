@@ -54,7 +54,7 @@ pub(crate) fn run(args: &EditArgs) -> Result<()> {
             (&args.file, offline::takes::input_limit()),
             &request,
             &args.out,
-            args.block_frames,
+            (args.block_frames, args.keep_mb.saturating_mul(1 << 20)),
             progress.as_mut(),
         );
         let s = super::progress::settle(progress.as_mut(), done).map_err(usage)?;

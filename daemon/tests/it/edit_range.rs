@@ -161,7 +161,9 @@ fn ranged_emotion_edits_are_the_whole_edit_cut_in_any_block_size() {
             let out = dir.path().join(format!("out.{ext}"));
             for block in [1, 7, 64, 100_000] {
                 let m = (model_path.as_path(), &model);
-                let s = edit::edit_file(m, (&input, LIMIT), request, &out, block, &mut Silent)
+                // Some of the first pass's projections kept, the rest made again.
+                let streaming = (block, 4096);
+                let s = edit::edit_file(m, (&input, LIMIT), request, &out, streaming, &mut Silent)
                     .expect("ranged edit");
                 assert_eq!(s.frames, expected.n_frames(), "{ext}, blocks of {block}");
                 let got = replay::load(&out).expect("reads");

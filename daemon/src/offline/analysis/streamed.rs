@@ -179,6 +179,7 @@ fn project(model: &IcaModel, input: &TakeInput, frames: usize) -> Result<Vec<f32
         (&mut source, &map),
         BLOCK_FRAMES,
         progress,
+        streamed::Reuse::Off,
         &mut sink,
     )?;
     Ok(sink.0)

@@ -5,7 +5,9 @@
 //! so the low-pass, the glitch reference and the held pose reach the range as they would in
 //! the whole take, and reading stops after it: the output is the same range cut from the whole
 //! edit, its first frame numbered as in the input. A `--to-emotion` without `--lowpass` still
-//! measures the whole take's mean (its first pass), as the whole edit does.
+//! measures the whole take's mean (its first pass), as the whole edit does. That pass keeps
+//! its frames' projections, up to a budget of memory, and the edit takes them back
+//! ([`crate::offline::streamed::Kept`]).
 
 use std::path::Path;
 
@@ -16,8 +18,8 @@ use replay::TakeWriter;
 use super::{plan, ComponentSums, EditRequest, FrameEditor, Output};
 use crate::offline::progress::Progress;
 use crate::offline::streamed::{
-    label_map, run_pass, source_notices, with_writer, BlockWrite, Frame, FrameSink, Handoff,
-    PendingOut, Source,
+    label_map, run_pass, source_notices, with_writer, BlockWrite, Frame, FrameSink, Handoff, Kept,
+    PendingOut, Reuse, Source,
 };
 use crate::offline::trim::{Cut, Span};
 use engine::frame::FrameProcessor;
@@ -33,7 +35,9 @@ pub struct EditSummary {
 
 /// Edits the take at `path` (at most `max_bytes`) under `model` (from `model_path`) as
 /// `request` asks and writes it to `out` (format by extension), `block_frames` frames at a
-/// time. The file is byte for byte what
+/// time (`streaming`'s first). A two-pass edit keeps up to `streaming`'s second, in bytes, of
+/// the first pass's projections for the second
+/// ([`crate::offline::streamed::KEEP_BYTES`] by default). The file is byte for byte what
 /// [`crate::offline::edit::edit_take`] and [`replay::save`] give, except that a TRC or C3D
 /// output of a CSV input (no frame count in its header) gets a padded header.
 ///
@@ -44,29 +48,25 @@ pub fn edit_file(
     (path, max_bytes): (&Path, u64),
     request: &EditRequest,
     out: &Path,
-    block_frames: usize,
+    streaming @ (block_frames, _): (usize, usize),
     progress: &mut dyn Progress,
 ) -> Result<EditSummary> {
-    if request.replace_from.is_some() || request.add_from.is_some() {
-        bail!("Copy & Replace and Copy & Add align whole takes: use edit_take");
-    }
-    // Named here: the file written first is the hidden one (see the module docs).
-    if replay::Format::from_path(out).is_none() {
-        return Err(replay::WriteError::UnknownFormat(out.into()).into());
-    }
+    streamable(request, out)?;
     let mut plan = plan(request, model_path, model)?;
     let mut source = Source::open(path, max_bytes)?;
     let map = label_map(model, &source)?;
     let notices = source_notices(model, &source, &map);
+    let mut kept = None;
     if plan.needs_means() {
-        measure(
+        kept = Some(measure(
             model,
             (&mut source, &map),
-            block_frames,
+            streaming,
             &mut *progress,
             &mut plan,
-        )?;
+        )?);
     }
+    let reuse = kept.as_ref().map_or(Reuse::Off, Reuse::TakeBack);
     let header = source.empty_take();
     let (span, cut, declared) = range_of(&header, source.frames(), request)?;
     let output = Output::new(&header, model.labels(), &map);
@@ -88,7 +88,8 @@ pub fn edit_file(
             written: 0,
         };
         let pass = (&mut source, &map);
-        let read = run_pass(model, pass, block_frames, (progress, "editing"), &mut sink)?;
+        let stage = (progress, "editing");
+        let read = run_pass(model, pass, block_frames, stage, reuse, &mut sink)?;
         Ok((read, sink.written))
     })?;
     if frames == 0 {
@@ -97,6 +98,18 @@ pub fn edit_file(
     }
     pending.commit()?;
     Ok(EditSummary { frames, notices })
+}
+
+/// Refuses what the streamed edit cannot do, before any file is touched.
+fn streamable(request: &EditRequest, out: &Path) -> Result<()> {
+    if request.replace_from.is_some() || request.add_from.is_some() {
+        bail!("Copy & Replace and Copy & Add align whole takes: use edit_take");
+    }
+    // Named here: the file written first is the hidden one (see the module docs).
+    if replay::Format::from_path(out).is_none() {
+        return Err(replay::WriteError::UnknownFormat(out.into()).into());
+    }
+    Ok(())
 }
 
 /// The range `request` writes of a take with `header`'s numbering and `frames` frames (when
@@ -119,25 +132,29 @@ fn range_of(
 }
 
 /// The first pass of a mean-based edit: the take's mean components settle `plan`; the source
-/// is rewound for the edit.
+/// is rewound for the edit. Returns the frames' projections, kept up to `keep_bytes`.
 fn measure(
     model: &IcaModel,
     (source, map): (&mut Source, &engine::LabelMap),
-    block_frames: usize,
+    (block_frames, keep_bytes): (usize, usize),
     progress: &mut dyn Progress,
     plan: &mut super::Plan,
-) -> Result<()> {
+) -> Result<Kept> {
+    let mut kept = Kept::new(keep_bytes, model.components(), source.frames());
     let mut sums = Sums(ComponentSums::new(model.components()));
     let pass = (&mut *source, map);
+    let stage = (progress, "measuring");
     run_pass(
         model,
         pass,
         block_frames,
-        (progress, "measuring"),
+        stage,
+        Reuse::Keep(&mut kept),
         &mut sums,
     )?;
     plan.settle(model, &sums.0);
-    source.rewind()
+    source.rewind()?;
+    Ok(kept)
 }
 
 /// The first pass of a mean-based edit.

@@ -17,6 +17,7 @@
 mod handoff;
 mod output;
 mod project;
+mod reuse;
 mod source;
 
 pub use project::{project_file, ProjectSummary};
@@ -31,6 +32,8 @@ use engine::frame::{FrameProcessor, Prepared};
 use engine::LabelMap;
 pub(crate) use handoff::{with_writer, BlockWrite, Handoff};
 pub(crate) use output::PendingOut;
+pub use reuse::KEEP_BYTES;
+pub(crate) use reuse::{Kept, Reuse};
 pub(crate) use source::Source;
 
 /// Frames per block: for a hundred markers the block's buffers (records read, decoded take,
@@ -84,16 +87,25 @@ pub(crate) fn label_map(model: &IcaModel, source: &Source) -> Result<LabelMap> {
 type ReadBlock = Result<(replay::Take, ModelFrames)>;
 
 /// Projects each frame of a block (its frames in model order beside it), the first of them
-/// frame `index` of the take, and hands it to `sink`.
+/// frame `index` of the take, or takes its projection back from a first pass, and hands it to
+/// `sink`.
 fn feed(
     (block, frames): (&replay::Take, &ModelFrames),
     index: usize,
     (processor, u): (&mut FrameProcessor, &mut [f32]),
+    reuse: &mut Reuse<'_>,
     sink: &mut dyn FrameSink,
 ) -> Result<()> {
     for k in 0..block.n_frames() {
         let (xyz, missing) = frames.frame(k);
-        let prepared = processor.project(xyz, missing, u)?;
+        let prepared = match reuse.take_back(index + k, u) {
+            Some(kept) => kept,
+            None => {
+                let prepared = processor.project(xyz, missing, u)?;
+                reuse.keep(prepared, u, processor);
+                prepared
+            }
+        };
         sink.frame(Frame {
             index: index + k,
             source: (block.frame(k), block.frame_missing(k)),
@@ -139,6 +151,8 @@ fn read_blocks(
 /// processes the current: the frames are processed in order by one processor, as before, and
 /// the sink sees them in order. Two blocks' buffers go round between the two threads.
 ///
+/// `reuse` keeps the frames' projections for a second pass, or takes them back from a first.
+///
 /// # Errors
 /// The source's read errors (naming the file), or the sink's.
 pub(crate) fn run_pass(
@@ -146,10 +160,11 @@ pub(crate) fn run_pass(
     (source, map): (&mut Source, &LabelMap),
     block_frames: usize,
     (progress, name): (&mut dyn Progress, &str),
+    mut reuse: Reuse<'_>,
     sink: &mut dyn FrameSink,
 ) -> Result<usize> {
     progress.step(name, "frames", source.frames().map(|n| n as u64));
-    let mut processor = FrameProcessor::new(model);
+    let mut processor = reuse.processor(|| FrameProcessor::new(model));
     let mut u = vec![0.0f32; model.components()];
     let mut index = 0;
     let path = source.path().to_path_buf();
@@ -164,7 +179,8 @@ pub(crate) fn run_pass(
         s.spawn(move || read_blocks((source, map), block_frames, free_rx, full_tx));
         for read in full_rx {
             let (block, frames) = read?;
-            feed((&block, &frames), index, (&mut processor, &mut u), sink)?;
+            let state = (&mut processor, &mut u[..]);
+            feed((&block, &frames), index, state, &mut reuse, sink)?;
             index += block.n_frames();
             sink.end_block()?;
             progress.advance(block.n_frames() as u64);

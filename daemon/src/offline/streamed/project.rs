@@ -9,7 +9,7 @@ use ica_core::model::IcaModel;
 
 use super::{
     label_map, run_pass, source_notices, with_writer, BlockWrite, Frame, FrameSink, Handoff,
-    PendingOut, Source,
+    PendingOut, Reuse, Source,
 };
 use crate::offline::progress::Progress;
 
@@ -74,7 +74,7 @@ pub fn project_file(
         };
         let pass = (&mut source, &map);
         let stage = (progress, "projecting");
-        let frames = run_pass(model, pass, block_frames, stage, &mut rows)?;
+        let frames = run_pass(model, pass, block_frames, stage, Reuse::Off, &mut rows)?;
         Ok((frames, rows.masked, rows.held))
     })?;
     pending.commit()?;

@@ -1,0 +1,104 @@
+//! A first pass's projections, kept for the second (issue 35).
+//!
+//! `edit --to-emotion` reads a take twice: once for its mean components, once to edit it.
+//! One processor sees the same frames in the same order both times, so every frame's
+//! preparation (glitch checks, head pose) and projection come out the same; the second pass
+//! redid them, a third of a 1-hour edit's CPU. The first pass now keeps them, up to a budget
+//! of memory, with the processor's state after the last frame kept. The second takes them
+//! back and carries on from that state at the first frame it has none for, so the output is
+//! the same to the bit whatever the budget.
+
+use engine::frame::{FrameProcessor, Prepared};
+
+/// Memory a first pass keeps for the second, by default: 83 minutes at 120 Hz and 20 components
+/// (224 bytes a frame); a longer take is prepared and projected again after that.
+pub const KEEP_BYTES: usize = 128 << 20;
+
+/// Frames' projections kept, in order from the take's first frame.
+pub(crate) struct Kept {
+    prepared: Vec<Prepared>,
+    /// `components` values a frame.
+    u: Vec<f32>,
+    components: usize,
+    /// Most frames kept.
+    limit: usize,
+    /// The processor's state after the last frame kept, once the budget is full.
+    resume: Option<FrameProcessor>,
+}
+
+impl Kept {
+    /// Room for what `bytes` of memory holds of frames of `components` components (`bytes`
+    /// 0 keeps nothing), at most `frames` when the take's length is known.
+    pub(crate) fn new(bytes: usize, components: usize, frames: Option<usize>) -> Kept {
+        let per_frame = std::mem::size_of::<Prepared>() + components * std::mem::size_of::<f32>();
+        let limit = bytes / per_frame;
+        // A header's count may lie: reserve for it only within the budget.
+        let reserve = frames.map_or(0, |n| n.min(limit));
+        Kept {
+            prepared: Vec::with_capacity(reserve),
+            u: Vec::with_capacity(reserve * components),
+            components,
+            limit,
+            resume: None,
+        }
+    }
+
+    /// Keeps a frame's projection while there is room; `processor` has just made it.
+    fn keep(&mut self, prepared: Prepared, u: &[f32], processor: &FrameProcessor) {
+        if self.prepared.len() == self.limit {
+            return;
+        }
+        self.prepared.push(prepared);
+        self.u.extend_from_slice(&u[..self.components]);
+        if self.prepared.len() == self.limit {
+            self.resume = Some(processor.clone());
+        }
+    }
+
+    /// Frame `index`'s projection into `u`, when it was kept.
+    fn take_back(&self, index: usize, u: &mut [f32]) -> Option<Prepared> {
+        let prepared = *self.prepared.get(index)?;
+        let m = self.components;
+        u[..m].copy_from_slice(&self.u[index * m..(index + 1) * m]);
+        Some(prepared)
+    }
+}
+
+/// What a pass does with [`Kept`] projections.
+pub(crate) enum Reuse<'a> {
+    /// Neither keeps nor takes back.
+    Off,
+    /// Keeps each frame's projection while there is room (the first pass).
+    Keep(&'a mut Kept),
+    /// Takes back the projections kept, and projects the frames after them (the second).
+    TakeBack(&'a Kept),
+}
+
+impl Reuse<'_> {
+    /// The processor a pass starts with: a new one, or the state the first pass reached after
+    /// its last frame kept.
+    pub(crate) fn processor(&self, new: impl FnOnce() -> FrameProcessor) -> FrameProcessor {
+        match self {
+            Reuse::TakeBack(Kept {
+                resume: Some(state),
+                ..
+            }) => state.clone(),
+            _ => new(),
+        }
+    }
+
+    /// Frame `index`'s projection into `u`, when it was kept and this pass takes it back.
+    pub(crate) fn take_back(&self, index: usize, u: &mut [f32]) -> Option<Prepared> {
+        match self {
+            Reuse::TakeBack(kept) => kept.take_back(index, u),
+            _ => None,
+        }
+    }
+
+    /// Keeps a frame's projection, when this pass keeps them.
+    pub(crate) fn keep(&mut self, prepared: Prepared, u: &[f32], processor: &FrameProcessor) {
+        if let Reuse::Keep(kept) = self {
+            kept.keep(prepared, u, processor);
+        }
+    }
+}
