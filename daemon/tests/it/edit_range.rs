@@ -9,7 +9,7 @@ use crate::common::{ok, p, run};
 use daemon::offline::edit::{self, edit_take, EditRequest};
 use daemon::offline::progress::Silent;
 use daemon::offline::trim::{frame_range, FrameOrTime};
-use daemon::offline::{self};
+use daemon::offline::{self, streamed};
 use replay::Take;
 
 const LIMIT: u64 = 1 << 30;
@@ -161,8 +161,14 @@ fn ranged_emotion_edits_are_the_whole_edit_cut_in_any_block_size() {
             let out = dir.path().join(format!("out.{ext}"));
             for block in [1, 7, 64, 100_000] {
                 let m = (model_path.as_path(), &model);
-                // Some of the first pass's projections kept, the rest made again.
-                let streaming = (block, 4096);
+                // Some of the first pass's projections kept (the rest made again), or all of
+                // them (the take is not read again).
+                let keep = if block % 2 == 1 {
+                    4096
+                } else {
+                    streamed::KEEP_BYTES
+                };
+                let streaming = (block, keep);
                 let s = edit::edit_file(m, (&input, LIMIT), request, &out, streaming, &mut Silent)
                     .expect("ranged edit");
                 assert_eq!(s.frames, expected.n_frames(), "{ext}, blocks of {block}");

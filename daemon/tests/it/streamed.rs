@@ -252,8 +252,12 @@ fn a_take_whose_markers_or_rate_differ_from_the_model_is_named_in_the_notices() 
     let s =
         streamed::project_file(&model, (&input, LIMIT), &out, 100, &mut Silent).expect("projected");
     assert_eq!(s.notices, want);
+    // A mean-based edit keeps every projection of the first pass, yet reads the take again
+    // for the marker the model lacks, which the output carries unchanged.
     let request = EditRequest {
         translate: vec![(0, 1.0)],
+        to_emotion: Some("happy".into()),
+        amount: 0.5,
         ..EditRequest::default()
     };
     let edited = dir.path().join("e.c3d");
@@ -267,4 +271,8 @@ fn a_take_whose_markers_or_rate_differ_from_the_model_is_named_in_the_notices() 
     )
     .expect("edited");
     assert_eq!(s.notices, want);
+    let whole = edit_take(&model, &model_path, &take, &input, &request).expect("whole edit");
+    let got = replay::load(&edited).expect("readable");
+    assert_eq!(got.labels.last().map(String::as_str), Some("Renamed"));
+    assert_eq!(got, whole);
 }

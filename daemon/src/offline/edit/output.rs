@@ -34,6 +34,11 @@ impl<'a> Output<'a> {
         }
     }
 
+    /// Whether frames carry markers of the take the model lacks, copied from it.
+    pub(crate) fn copies_extra(&self) -> bool {
+        !self.map.extra.is_empty()
+    }
+
     /// Appends frame index `f` (counted from the take's first frame, for the error): the
     /// edited model markers and their input gaps, then the source frame's extra markers.
     ///

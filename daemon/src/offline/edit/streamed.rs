@@ -18,8 +18,8 @@ use replay::TakeWriter;
 use super::{plan, ComponentSums, EditRequest, FrameEditor, Output};
 use crate::offline::progress::Progress;
 use crate::offline::streamed::{
-    label_map, run_pass, source_notices, with_writer, BlockWrite, Frame, FrameSink, Handoff, Kept,
-    PendingOut, Reuse, Source,
+    label_map, replay_pass, run_pass, source_notices, with_writer, BlockWrite, Frame, FrameSink,
+    Handoff, Kept, PendingOut, Reuse, Source,
 };
 use crate::offline::trim::{Cut, Span};
 use engine::frame::FrameProcessor;
@@ -66,7 +66,6 @@ pub fn edit_file(
             &mut plan,
         )?);
     }
-    let reuse = kept.as_ref().map_or(Reuse::Off, Reuse::TakeBack);
     let header = source.empty_take();
     let (span, cut, declared) = range_of(&header, source.frames(), request)?;
     let output = Output::new(&header, model.labels(), &map);
@@ -77,7 +76,7 @@ pub fn edit_file(
     let spare = output.take.clone();
     // The blocks are encoded and written on a thread of their own while the next is edited.
     let (read, frames) = with_writer(spare, TakeOut(writer, out), |handoff| {
-        let mut sink = Edit {
+        let sink = Edit {
             editor: plan.editor(model)?,
             resynth: FrameProcessor::new(model),
             edited: vec![0.0; model.channels()],
@@ -88,9 +87,7 @@ pub fn edit_file(
             written: 0,
         };
         let pass = (&mut source, &map);
-        let stage = (progress, "editing");
-        let read = run_pass(model, pass, block_frames, stage, reuse, &mut sink)?;
-        Ok((read, sink.written))
+        sink.run(model, pass, (kept.as_ref(), block_frames), progress)
     })?;
     if frames == 0 {
         // Only a take whose length its header does not give gets here (else `check` said it).
@@ -181,6 +178,31 @@ struct Edit<'a> {
     written: usize,
 }
 
+impl Edit<'_> {
+    /// The edit pass: over the projections `kept` by the first pass when they are the whole
+    /// take's and nothing else of it is needed, else over the take read again (taking back
+    /// what was kept). Returns the frames seen and the frames written.
+    fn run(
+        mut self,
+        model: &IcaModel,
+        pass: (&mut Source, &engine::LabelMap),
+        (kept, block_frames): (Option<&Kept>, usize),
+        progress: &mut dyn Progress,
+    ) -> Result<(usize, usize)> {
+        let stage = (progress, "editing");
+        let read = match kept {
+            Some(kept) if kept.is_whole() && !self.reads_frames() => {
+                replay_pass(kept, (model.markers(), block_frames), stage, &mut self)?
+            }
+            _ => {
+                let reuse = kept.map_or(Reuse::Off, Reuse::TakeBack);
+                run_pass(model, pass, block_frames, stage, reuse, &mut self)?
+            }
+        };
+        Ok((read, self.written))
+    }
+}
+
 impl FrameSink for Edit<'_> {
     fn frame(&mut self, frame: Frame<'_>) -> Result<()> {
         // Frames before the range are edited too: the edit's state reaches it as in the
@@ -200,6 +222,12 @@ impl FrameSink for Edit<'_> {
 
     fn is_past(&self, index: usize) -> bool {
         self.cut.is_past(index)
+    }
+
+    /// The edited model markers replace the take's, and its gaps are filled: only the take's
+    /// gaps (`keep_gaps`) and its markers the model lacks are read from it.
+    fn reads_frames(&self) -> bool {
+        self.keep_gaps || self.output.copies_extra()
     }
 
     fn end_block(&mut self) -> Result<()> {

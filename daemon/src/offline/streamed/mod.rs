@@ -33,7 +33,7 @@ use engine::LabelMap;
 pub(crate) use handoff::{with_writer, BlockWrite, Handoff};
 pub(crate) use output::PendingOut;
 pub use reuse::KEEP_BYTES;
-pub(crate) use reuse::{Kept, Reuse};
+pub(crate) use reuse::{replay_pass, Kept, Reuse};
 pub(crate) use source::Source;
 
 /// Frames per block: for a hundred markers the block's buffers (records read, decoded take,
@@ -46,9 +46,11 @@ pub const BLOCK_FRAMES: usize = 512;
 pub(crate) struct Frame<'a> {
     /// Frame index from the take's first frame.
     pub index: usize,
-    /// The frame as read (take markers), with its mask.
+    /// The frame as read (take markers), with its mask; empty in a pass that did not read the
+    /// take ([`FrameSink::reads_frames`]).
     pub source: (&'a [f32], &'a [bool]),
-    /// The frame in model order, with its mask.
+    /// The frame in model order, with its mask; in a pass that did not read the take, no
+    /// positions and a mask of every marker present.
     pub model: (&'a [f32], &'a [bool]),
     /// What preparing and projecting found.
     pub prepared: Prepared,
@@ -68,6 +70,11 @@ pub(crate) trait FrameSink {
     /// reading.
     fn is_past(&self, _index: usize) -> bool {
         false
+    }
+    /// Whether the sink reads the frames' positions or masks, not only their projections: a
+    /// pass whose projections were all kept reads the take again only for a sink that does.
+    fn reads_frames(&self) -> bool {
+        true
     }
 }
 

@@ -6,9 +6,15 @@
 //! redid them, a third of a 1-hour edit's CPU. The first pass now keeps them, up to a budget
 //! of memory, with the processor's state after the last frame kept. The second takes them
 //! back and carries on from that state at the first frame it has none for, so the output is
-//! the same to the bit whatever the budget.
+//! the same to the bit whatever the budget. When every frame was kept and the second pass
+//! needs nothing else of the take ([`super::FrameSink::reads_frames`]), it does not read the
+//! take again at all ([`replay_pass`]).
 
+use anyhow::Result;
 use engine::frame::{FrameProcessor, Prepared};
+
+use super::{Frame, FrameSink};
+use crate::offline::progress::Progress;
 
 /// Memory a first pass keeps for the second, by default: 83 minutes at 120 Hz and 20 components
 /// (224 bytes a frame); a longer take is prepared and projected again after that.
@@ -22,6 +28,8 @@ pub(crate) struct Kept {
     components: usize,
     /// Most frames kept.
     limit: usize,
+    /// Frames offered, kept or not.
+    seen: usize,
     /// The processor's state after the last frame kept, once the budget is full.
     resume: Option<FrameProcessor>,
 }
@@ -39,12 +47,14 @@ impl Kept {
             u: Vec::with_capacity(reserve * components),
             components,
             limit,
+            seen: 0,
             resume: None,
         }
     }
 
     /// Keeps a frame's projection while there is room; `processor` has just made it.
     fn keep(&mut self, prepared: Prepared, u: &[f32], processor: &FrameProcessor) {
+        self.seen += 1;
         if self.prepared.len() == self.limit {
             return;
         }
@@ -62,6 +72,52 @@ impl Kept {
         u[..m].copy_from_slice(&self.u[index * m..(index + 1) * m]);
         Some(prepared)
     }
+
+    /// Whether every frame the first pass saw was kept.
+    pub(crate) fn is_whole(&self) -> bool {
+        self.prepared.len() == self.seen
+    }
+}
+
+/// A pass over the frames of a take `kept` holds whole, without reading it: each frame's kept
+/// projection to `sink`, which must not read frames ([`FrameSink::reads_frames`]), in blocks
+/// of `block_frames`, until the sink is past the next; `markers` in the model. Reports
+/// progress as step `name`; returns the frames seen.
+pub(crate) fn replay_pass(
+    kept: &Kept,
+    (markers, block_frames): (usize, usize),
+    (progress, name): (&mut dyn Progress, &str),
+    sink: &mut dyn FrameSink,
+) -> Result<usize> {
+    debug_assert!(kept.is_whole() && !sink.reads_frames());
+    let frames = kept.prepared.len();
+    progress.step(name, "frames", Some(frames as u64));
+    let present = vec![false; markers];
+    let mut u = vec![0.0f32; kept.components];
+    let mut index = 0;
+    while index < frames {
+        let end = frames.min(index + block_frames.max(1));
+        for i in index..end {
+            let Some(prepared) = kept.take_back(i, &mut u) else {
+                break;
+            };
+            let frame = Frame {
+                index: i,
+                source: (&[], &[]),
+                model: (&[], &present),
+                prepared,
+                u: &mut u,
+            };
+            sink.frame(frame)?;
+        }
+        sink.end_block()?;
+        progress.advance((end - index) as u64);
+        index = end;
+        if sink.is_past(index) {
+            break;
+        }
+    }
+    Ok(index)
 }
 
 /// What a pass does with [`Kept`] projections.
