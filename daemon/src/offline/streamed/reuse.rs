@@ -58,6 +58,17 @@ impl Kept {
         if self.prepared.len() == self.limit {
             return;
         }
+        if self.prepared.len() == self.prepared.capacity() {
+            // Grown by doubling as a Vec does, but never past the budget (a take whose length
+            // its header does not give).
+            let more = self
+                .prepared
+                .len()
+                .max(64)
+                .min(self.limit - self.prepared.len());
+            self.prepared.reserve_exact(more);
+            self.u.reserve_exact(more * self.components);
+        }
         self.prepared.push(prepared);
         self.u.extend_from_slice(&u[..self.components]);
         if self.prepared.len() == self.limit {
@@ -92,7 +103,7 @@ pub(crate) fn replay_pass(
     debug_assert!(kept.is_whole() && !sink.reads_frames());
     let frames = kept.prepared.len();
     progress.step(name, "frames", Some(frames as u64));
-    let present = vec![false; markers];
+    let none_missing = vec![false; markers];
     let mut u = vec![0.0f32; kept.components];
     let mut index = 0;
     while index < frames {
@@ -104,7 +115,7 @@ pub(crate) fn replay_pass(
             let frame = Frame {
                 index: i,
                 source: (&[], &[]),
-                model: (&[], &present),
+                model: (&[], &none_missing),
                 prepared,
                 u: &mut u,
             };
