@@ -40,11 +40,18 @@ impl Kept {
     pub(crate) fn new(bytes: usize, components: usize, frames: Option<usize>) -> Kept {
         let per_frame = std::mem::size_of::<Prepared>() + components * std::mem::size_of::<f32>();
         let limit = bytes / per_frame;
-        // A header's count may lie: reserve for it only within the budget.
+        // A header's count may lie: reserve for it only within the budget, and only if the
+        // memory is there (else the vectors grow with the frames actually read).
         let reserve = frames.map_or(0, |n| n.min(limit));
+        let (mut prepared, mut u) = (Vec::new(), Vec::new());
+        if prepared.try_reserve_exact(reserve).is_err()
+            || u.try_reserve_exact(reserve * components).is_err()
+        {
+            (prepared, u) = (Vec::new(), Vec::new());
+        }
         Kept {
-            prepared: Vec::with_capacity(reserve),
-            u: Vec::with_capacity(reserve * components),
+            prepared,
+            u,
             components,
             limit,
             seen: 0,
