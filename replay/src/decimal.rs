@@ -159,5 +159,9 @@ fn push_zeros(out: &mut String, count: i32) {
     }
 }
 
+mod read;
+
+pub(crate) use read::parse_plain;
+
 #[cfg(test)]
 mod tests;

@@ -136,7 +136,7 @@ pub(crate) fn parse_sample(cell: &str) -> Result<Sample, &'static str> {
     if cell.is_empty() {
         return Ok(Sample::Missing);
     }
-    match cell.parse::<f64>() {
+    match crate::decimal::parse_plain(cell).map_or_else(|| cell.parse::<f64>(), Ok) {
         Ok(v) if v.is_nan() => Ok(Sample::Missing),
         Ok(v) if v.is_finite() => Ok(Sample::Value(v)),
         _ => Err(EXPECTED_SAMPLE),
