@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use crate::common::{ok, p};
 use daemon::offline::edit::{self, edit_take, EditRequest};
-use daemon::offline::progress::Silent;
+use daemon::offline::progress::{Progress, Silent};
 use daemon::offline::{self, streamed};
 use ica_core::model::IcaModel;
 use replay::{Format, Take};
@@ -152,11 +152,45 @@ fn streamed_edits_write_what_the_whole_take_edit_writes() {
             check_edit(m, &input, &mean, format);
         }
     }
+    // With every frame's projection kept and nothing else of the take needed, the edit pass
+    // does not read the take: emptied as that pass begins, it is not missed. With
+    // `--keep-gaps` the pass reads the take again and finds it emptied.
+    let out = dir.path().join("kept.c3d");
+    let whole = edit_take(&model, &model_path, &take, &c3d, &mean).expect("whole edit");
+    let streaming = (7, streamed::KEEP_BYTES);
+    let mut emptied = EmptiesOnEditing(c3d.clone());
+    edit::edit_file(m, (&c3d, LIMIT), &mean, &out, streaming, &mut emptied)
+        .expect("the take is not read again");
+    assert_eq!(replay::load(&out).expect("readable"), whole);
+    let c3d = save_as(dir.path(), &take, "in.c3d");
+    let mut emptied = EmptiesOnEditing(c3d.clone());
+    edit::edit_file(
+        m,
+        (&c3d, LIMIT),
+        &blend_keep_gaps,
+        &out,
+        streaming,
+        &mut emptied,
+    )
+    .expect_err("the take is read again, and was emptied");
     // A CSV without `rate_hz` is read whole (its rate needs every row) and edited in blocks.
     let text = std::fs::read_to_string(dir.path().join("in.csv")).expect("csv");
     let no_rate = dir.path().join("no_rate.csv");
     std::fs::write(&no_rate, text.split_once('\n').expect("comment line").1).expect("written");
     check_edit(m, &no_rate, &mean, Format::Trc);
+}
+
+/// Empties the input file as the edit pass begins.
+struct EmptiesOnEditing(PathBuf);
+
+impl Progress for EmptiesOnEditing {
+    fn step(&mut self, name: &str, _unit: &'static str, _total: Option<u64>) {
+        if name == "editing" {
+            std::fs::write(&self.0, b"").expect("emptied");
+        }
+    }
+
+    fn advance(&mut self, _n: u64) {}
 }
 
 /// `project`'s CSV of the whole take, as the whole-take path computes it.
