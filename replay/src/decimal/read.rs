@@ -3,10 +3,11 @@
 //! (finding the number's parts, then Eisel-Lemire) was most of the time reading them took
 //! after the cells were split (perf of `train` on the AnimFace TRC takes: 15 % of its CPU).
 //!
-//! A decimal of at most 19 significant digits, none after the 22nd past the point, whose digits read as an
-//! integer `m ≤ 2^53`, is `m / 10^k` with both operands exact in `f64`: one IEEE division
-//! rounds it correctly, which is what std returns (Clinger's fast path). Any other text goes to
-//! std. `tests` checks the two agree, bit for bit, on generated decimals and on the edges.
+//! A decimal of at most 19 significant digits, none after the 22nd past the point, whose
+//! digits read as an integer `m ≤ 2^53`, is `m / 10^k` with both operands exact in `f64`: one
+//! IEEE division rounds it correctly, which is what std returns (Clinger's fast path). Any
+//! other text goes to std. `tests` checks the two agree, bit for bit, on generated decimals
+//! and on the edges.
 
 /// Powers of ten exact in `f64`.
 const POW10: [f64; 23] = [
@@ -16,8 +17,8 @@ const POW10: [f64; 23] = [
 
 /// `text.parse::<f64>()` for a plain decimal: an optional sign, digits with at most one point
 /// among or around them, at most 19 from the first nonzero one, at most 22 after the point,
-/// their integer at most 2^53. `None` for any other text (an exponent, `NaN`, spaces, more digits): the caller asks
-/// std.
+/// their integer at most 2^53. `None` for any other text (an exponent, `NaN`, spaces, more
+/// digits): the caller asks std.
 pub(crate) fn parse_plain(text: &str) -> Option<f64> {
     let bytes = text.as_bytes();
     let (negative, digits) = match bytes.first()? {
