@@ -63,7 +63,13 @@ fn the_header_counts_the_frames_on_disk_within_a_sync_and_finish_counts_all() {
     for f in 0u32..10 {
         file.append(&f.to_le_bytes()).expect("appended");
     }
+    // One sync period is enough on an idle host; a loaded one (a CI build on both cores, a
+    // disk busy with another job's writeback) may take a few: wait for it, within bounds.
+    let deadline = std::time::Instant::now() + 10 * (SYNC + FLUSH);
     std::thread::sleep(SYNC + FLUSH);
+    while on_disk(&path) != (10, 40) && std::time::Instant::now() < deadline {
+        std::thread::sleep(FLUSH);
+    }
     assert_eq!(on_disk(&path), (10, 40), "counted without a finish");
     file.append(&10u32.to_le_bytes()).expect("appended");
     assert_eq!(file.finish().expect("closed"), 11);
