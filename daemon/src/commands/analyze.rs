@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use ica_core::model::IcaModel;
 
 use crate::cli::AnalyzeArgs;
@@ -81,13 +81,16 @@ pub(crate) fn analyze_and_write(
         Some(p) => p.to_path_buf(),
         None => session.base_dir.join("regions.toml"),
     };
-    let regions = analysis::resolve_regions(&regions_path, &model).with_context(|| {
-        format!(
-            "analyze needs a regions file naming the mouth, eyebrows and eyelids markers; \
-             propose one with `emoshift regions TAKE --out {}`, check it, and run again",
+    if !regions_path.exists() {
+        bail!(
+            "analyze needs a regions file naming the mouth, eyebrows and eyelids markers, and \
+             {} does not exist; propose one with `emoshift regions TAKE --out {}`, check it, \
+             and run again",
+            regions_path.display(),
             regions_path.display()
-        )
-    })?;
+        );
+    }
+    let regions = analysis::resolve_regions(&regions_path, &model)?;
     let inputs = Inputs {
         model: &model,
         model_path,

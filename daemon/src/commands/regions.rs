@@ -9,12 +9,24 @@ use crate::offline::regions;
 pub(crate) fn run(args: &RegionsArgs) -> Result<()> {
     crate::offline::output::check_out(&args.out, &[&args.take], args.force)?;
     let take = crate::offline::load_take(&args.take)?;
-    let proposals = regions::propose(&take);
-    let text = regions::to_toml(&proposals, &args.take.display().to_string());
+    let proposed = regions::propose(&take);
+    let text = regions::to_toml(&proposed, &args.take.display().to_string());
     std::fs::write(&args.out, text)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
+    for (label, share) in &proposed.left_out {
+        crate::out!(
+            "left out {label}: missing in {:.1} % of the frames (train leaves out markers \
+             missing in over {:.0} %)",
+            100.0 * share,
+            100.0 * crate::offline::training::DEFAULT_MAX_MISSING
+        );
+    }
     for region in ["mouth", "eyebrows", "eyelids", "head_reference"] {
-        let n = proposals.iter().filter(|p| p.region == region).count();
+        let n = proposed
+            .markers
+            .iter()
+            .filter(|p| p.region == region)
+            .count();
         crate::out!("{region}: {n} markers");
     }
     crate::out!(

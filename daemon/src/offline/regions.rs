@@ -8,6 +8,8 @@ use std::fmt::Write as _;
 
 use replay::Take;
 
+use crate::offline::training::DEFAULT_MAX_MISSING;
+
 /// Name fragments (lower case, asset prefix removed) that put a marker in a region, in the
 /// order regions are tried: a brow is never an eyelid, whatever else its name says.
 const BY_NAME: [(&str, &[&str]); 4] = [
@@ -43,10 +45,32 @@ fn bare(label: &str) -> &str {
     label.rsplit_once(':').map_or(label, |(_, m)| m)
 }
 
-/// The proposals for `take`: by name first; a region no name fills, from the geometry.
-pub fn propose(take: &Take) -> Vec<Proposal> {
+/// What `regions` proposes for a take.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Proposed {
+    /// The markers proposed, region by region.
+    pub markers: Vec<Proposal>,
+    /// Markers left out with the share of frames they are missing in: `train` leaves them out
+    /// of the model (above [`DEFAULT_MAX_MISSING`]), so `analyze` could not find them.
+    pub left_out: Vec<(String, f64)>,
+}
+
+/// The proposals for `take`: by name first; a region no name fills, from the geometry. A
+/// marker missing in more of the take's frames than `train` keeps is proposed for no region.
+pub fn propose(take: &Take) -> Proposed {
+    let frames = take.n_frames().max(1) as f64;
+    let share: Vec<f64> = take
+        .missing_per_marker()
+        .iter()
+        .map(|&gone| gone as f64 / frames)
+        .collect();
+    let kept = |i: usize| share[i] <= DEFAULT_MAX_MISSING;
+    let left_out = (0..take.n_markers())
+        .filter(|&i| !kept(i))
+        .map(|i| (take.labels[i].clone(), share[i]))
+        .collect();
     let mut out: Vec<Proposal> = Vec::new();
-    for (i, label) in take.labels.iter().enumerate() {
+    for (i, label) in take.labels.iter().enumerate().filter(|(i, _)| kept(*i)) {
         let name = bare(label).to_lowercase();
         let hit = BY_NAME.iter().find_map(|(region, keys)| {
             let key = keys.iter().find(|k| name.contains(*k))?;
@@ -61,14 +85,22 @@ pub fn propose(take: &Take) -> Vec<Proposal> {
             });
         }
     }
-    let stats = marker_stats(take);
+    let mut stats = marker_stats(take);
+    for (i, s) in stats.iter_mut().enumerate() {
+        if !kept(i) {
+            *s = None;
+        }
+    }
     for region in ["mouth", "eyebrows", "eyelids", "head_reference"] {
         if !out.iter().any(|p| p.region == region) {
             let taken: Vec<String> = out.iter().map(|p| p.label.clone()).collect();
             out.extend(by_geometry(take, &stats, region, &taken));
         }
     }
-    out
+    Proposed {
+        markers: out,
+        left_out,
+    }
 }
 
 /// Per marker: mean position and RMS motion about it (mm), over the frames where it is seen.
@@ -162,13 +194,24 @@ fn by_geometry(
         .collect()
 }
 
-/// The proposals as `regions.toml`, one marker a line with its reason.
-pub fn to_toml(proposals: &[Proposal], source: &str) -> String {
+/// The proposals as `regions.toml`, one marker a line with its reason, and the markers left
+/// out in a comment.
+pub fn to_toml(proposed: &Proposed, source: &str) -> String {
+    let proposals = &proposed.markers;
     let mut out = format!(
         "# regions.toml proposed by `emoshift regions` from {source}: check every line before\n\
          # `emoshift analyze` (which needs mouth, eyebrows and eyelids); head_reference names\n\
          # markers that move with the head only, for `train`.\n"
     );
+    for (label, share) in &proposed.left_out {
+        let _ = writeln!(
+            out,
+            "# left out: {label:?}, missing in {:.1} % of the frames (train leaves out markers \
+             missing in over {:.0} %)",
+            100.0 * share,
+            100.0 * DEFAULT_MAX_MISSING
+        );
+    }
     for region in ["mouth", "eyebrows", "eyelids", "head_reference"] {
         if !proposals.iter().any(|p| p.region == region) {
             let _ = writeln!(out, "# {region}: no marker found; name its markers here");
@@ -187,6 +230,14 @@ pub fn to_toml(proposals: &[Proposal], source: &str) -> String {
 mod tests {
     use super::*;
 
+    fn of<'a>(p: &'a Proposed, region: &str) -> Vec<&'a str> {
+        p.markers
+            .iter()
+            .filter(|x| x.region == region)
+            .map(|x| x.label.as_str())
+            .collect()
+    }
+
     #[test]
     fn names_with_motives_prefix_and_numbered_layouts_both_get_regions() {
         let labels = [
@@ -199,16 +250,10 @@ mod tests {
         let mut take = Take::new(labels.iter().map(|s| s.to_string()).collect(), 100.0, 1);
         take.push_frame(&[0.0; 15], &[false; 5]);
         let p = propose(&take);
-        let of = |r: &str| -> Vec<&str> {
-            p.iter()
-                .filter(|x| x.region == r)
-                .map(|x| x.label.as_str())
-                .collect()
-        };
-        assert_eq!(of("eyebrows"), ["Face:BrowL"]);
-        assert_eq!(of("mouth"), ["Face:UpperLip"]);
-        assert_eq!(of("eyelids"), ["Face:LidR"]);
-        assert_eq!(of("head_reference"), ["Face:HeadTop"]);
+        assert_eq!(of(&p, "eyebrows"), ["Face:BrowL"]);
+        assert_eq!(of(&p, "mouth"), ["Face:UpperLip"]);
+        assert_eq!(of(&p, "eyelids"), ["Face:LidR"]);
+        assert_eq!(of(&p, "head_reference"), ["Face:HeadTop"]);
         let text = to_toml(&p, "t.c3d");
         let back = replay::session::Regions::parse(&text).expect("valid regions.toml");
         assert!(back
@@ -226,14 +271,39 @@ mod tests {
         let xyz: Vec<f32> = heights.iter().flat_map(|&h| [0.0, h, 0.0]).collect();
         take.push_frame(&xyz, &[false; 5]);
         let p = propose(&take);
-        let of = |r: &str| -> Vec<&str> {
-            p.iter()
-                .filter(|x| x.region == r)
-                .map(|x| x.label.as_str())
-                .collect()
-        };
-        assert_eq!(of("mouth"), ["M0"]);
-        assert_eq!(of("eyelids"), ["M2"]);
-        assert_eq!(of("eyebrows"), ["M3", "M4"]);
+        assert_eq!(of(&p, "mouth"), ["M0"]);
+        assert_eq!(of(&p, "eyelids"), ["M2"]);
+        assert_eq!(of(&p, "eyebrows"), ["M3", "M4"]);
+        assert!(p.left_out.is_empty());
+    }
+
+    /// Facial-Sing's `Unlabeled1` is missing in 99 % of its frames: `train` leaves it out, so a
+    /// region naming it would stop `analyze`. Neither its name nor its place may propose it.
+    #[test]
+    fn a_marker_missing_in_most_frames_is_proposed_for_no_region() {
+        let labels = ["BrowL", "BrowR", "M2", "M3", "M4"];
+        let mut take = Take::new(labels.iter().map(|s| s.to_string()).collect(), 100.0, 1);
+        let heights = [190.0, 190.0, 10.0, 130.0, 200.0];
+        let xyz: Vec<f32> = heights.iter().flat_map(|&h| [0.0, h, 0.0]).collect();
+        for f in 0..4 {
+            // BrowR is missing in 2 of 4 frames (kept, as train keeps it); M4 in 3 of 4.
+            take.push_frame(&xyz, &[false, f < 2, false, false, f < 3]);
+        }
+        let p = propose(&take);
+        assert_eq!(of(&p, "eyebrows"), ["BrowL", "BrowR"]);
+        assert_eq!(p.left_out, [("M4".to_string(), 0.75)]);
+        assert!(!p.markers.iter().any(|x| x.label == "M4"), "{p:?}");
+        let text = to_toml(&p, "t.c3d");
+        assert!(
+            text.contains("# left out: \"M4\", missing in 75.0 % of the frames"),
+            "{text}"
+        );
+
+        // With no brow name, the top band comes from the geometry, without M4 in it.
+        let mut take = Take::new((0..5).map(|i| format!("M{i}")).collect(), 100.0, 1);
+        for f in 0..4 {
+            take.push_frame(&xyz, &[false, false, false, false, f < 3]);
+        }
+        assert_eq!(of(&propose(&take), "eyebrows"), ["M0", "M1"]);
     }
 }

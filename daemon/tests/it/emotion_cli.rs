@@ -137,6 +137,28 @@ fn inject_cuts_a_real_capture_into_a_paired_session_that_analyses_as_one() {
     let shown = ok(&["inspect", p(&model)]);
     assert!(shown.contains("1 axes fitted over all"), "{shown}");
     assert!(shown.contains("conditioning:"), "{shown}");
+    // A regions file proposed from one of its takes must not name Unlabeled1, which is
+    // missing in 99 % of the frames and so not in the model: analyze takes it as written.
+    let proposed = dir.path().join("proposed.toml");
+    let said = ok(&[
+        "regions",
+        p(&out.join("s01_level1.c3d")),
+        "--out",
+        p(&proposed),
+    ]);
+    assert!(said.contains("left out Unlabeled1: missing in"), "{said}");
+    let analysed = ok(&[
+        "analyze",
+        "--model",
+        p(&model),
+        "--manifest",
+        p(&out.join("session.toml")),
+        "--regions",
+        p(&proposed),
+        "--out",
+        p(&dir.path().join("proposed-report")),
+    ]);
+    assert!(analysed.contains("wrote "), "{analysed}");
     usage(
         &[
             "inject",

@@ -179,4 +179,20 @@ fn regions_proposes_a_file_that_analyze_takes() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+
+    // A name the model lacks: the error says it is the model's, and what to do.
+    let typo = dir.path().join("typo.toml");
+    std::fs::write(&typo, text.replacen("mouth = [", "mouth = [\"Nope\", ", 1)).expect("write");
+    let out = analyze(&["--regions", p(&typo)]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("names marker \"Nope\", which the model does not have")
+            && err.contains("remove or correct the name"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("emoshift regions TAKE"),
+        "the file exists: {err}"
+    );
 }

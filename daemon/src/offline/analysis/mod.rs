@@ -28,10 +28,10 @@ pub use svg::{timeline_takes, TimelineTake};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use ica_core::interpret::LabelRules;
 use ica_core::model::{IcaModel, Role};
-use replay::session::{Regions, Session};
+use replay::session::{Regions, Session, SessionError};
 use serde::Serialize;
 
 use crate::offline::{self, Projected};
@@ -194,9 +194,20 @@ pub fn project_session(model: &IcaModel, session: &Session) -> Result<Vec<Sessio
 /// Unreadable file, a region naming no marker, or a missing mouth/eyebrows/eyelids region.
 pub fn resolve_regions(path: &Path, model: &IcaModel) -> Result<BTreeMap<String, Vec<usize>>> {
     let regions = Regions::load(path)?;
-    let resolved = regions
-        .resolve(model.labels())
-        .with_context(|| format!("{}", path.display()))?;
+    let resolved = regions.resolve(model.labels()).map_err(|e| match e {
+        // The model's markers are the take's less those train left out: say so, not "take".
+        SessionError::UnknownLabel {
+            region,
+            label,
+            hint,
+        } => anyhow!(
+            "{}: region {region:?} names marker {label:?}, which the model does not have{hint}. \
+             train leaves out markers missing in most frames and says which: remove or correct \
+             the name in the file and run again",
+            path.display()
+        ),
+        e => anyhow::Error::new(e).context(path.display().to_string()),
+    })?;
     for (name, _) in ROLE_REGIONS {
         if !resolved.contains_key(name) {
             bail!(
