@@ -19,18 +19,16 @@
 //! channels missing everywhere and the moments are those of the used frames, with no per-frame
 //! memory. Call [`Moments::frame_is_used`] in a later pass to recognise a used frame.
 
-use nalgebra::{DMatrix, DMatrixView};
+use nalgebra::DMatrix;
 
 use super::kernels::{all_finite, centre_into};
 use super::stats::frame_is_used;
 use super::syrk::{accumulate_upper, rank_one_upper};
 use crate::input::{FitData, FitError};
 
-/// Used frames centred per syrk call: 128 x 327 f64 (335 KB) stays in L2 (see benches/stream.rs).
+/// Used frames centred per syrk call: 128 x 327 f64 (335 KB) stays in L2; 128 beat 256 and
+/// 512 by 3 and 17 % (see benches/stream.rs).
 const BLOCK_FRAMES: usize = 128;
-/// Channel block edge of the triangular update: 64 beat 48 and 96 by a few per cent at 327
-/// channels (see benches/stream.rs).
-const CHANNEL_BLOCK: usize = 64;
 
 /// Streaming per-channel mean and covariance of the used frames (see the module docs).
 ///
@@ -352,8 +350,7 @@ impl Moments {
                 *s += v;
             }
         }
-        let view = DMatrixView::from_slice(data, p, filled);
-        accumulate_upper(&mut self.m2, data, view, CHANNEL_BLOCK);
+        accumulate_upper(&mut self.m2, data);
     }
 
     /// Moves `(mean, M2)` from the old mean to the mean including the `added` new frames.

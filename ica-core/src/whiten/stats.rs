@@ -19,10 +19,6 @@ pub(crate) fn frame_is_used(missing_everywhere: &[bool], missing: Option<&[bool]
 /// Frames gathered per gemm call: large enough to amortise packing, small enough to stay in cache.
 const CHUNK_FRAMES: usize = 256;
 
-/// Channel block edge for the triangular covariance: only blocks on or above the diagonal are
-/// multiplied, saving close to half the flops of a full `X^T X`.
-const COV_BLOCK: usize = 96;
-
 /// Which frames and channels take part.
 #[derive(Debug)]
 pub(crate) struct Selection {
@@ -159,8 +155,8 @@ pub(crate) fn covariance<T: Copy + Into<f64>>(
 ) -> DMatrix<f64> {
     let nl = live.len();
     let mut cov = DMatrix::<f64>::zeros(nl, nl);
-    for_each_chunk(data, used, live, mean, |_, raw, chunk| {
-        accumulate_upper(&mut cov, raw, chunk, COV_BLOCK);
+    for_each_chunk(data, used, live, mean, |_, raw, _| {
+        accumulate_upper(&mut cov, raw);
     });
     mirror_upper(&mut cov);
     let dof = (used.len().max(2) - 1) as f64;
