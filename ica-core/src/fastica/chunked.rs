@@ -5,12 +5,12 @@
 //! blocks of [`BLOCK_FRAMES`] frames converted to f64, so its memory does not grow with the
 //! chunk, and allocates nothing after its first block.
 
-use nalgebra::{DMatrix, DMatrixViewMut};
+use nalgebra::DMatrix;
 
 use super::fused::Fused;
 use super::Contrast;
 use crate::input::FitError;
-use crate::linalg::{mul_add, strided};
+use crate::linalg::{cols, cols_mut, product};
 
 /// Frames per block: the block and its sources (2 x 1024 x m f64) stay in L2 at m = 20.
 pub(crate) const BLOCK_FRAMES: usize = 1024;
@@ -278,10 +278,11 @@ impl Scratch {
     fn sources(&mut self, w: &DMatrix<f64>, nb: usize) -> (&[f64], &mut [f64]) {
         let (k, m) = w.shape();
         self.y.resize(BLOCK_FRAMES.max(nb) * k, 0.0);
-        let zt = strided(&self.z, nb, m, m, 1);
-        let wt = strided(w.as_slice(), m, k, k, 1);
-        let mut yv = DMatrixViewMut::from_slice(&mut self.y[..nb * k], nb, k);
-        mul_add(&mut yv, 1.0, &zt, &wt, 0.0);
+        product(
+            cols_mut(&mut self.y, nb, k),
+            cols(&self.z, m, nb).transpose(),
+            cols(w.as_slice(), k, m).transpose(),
+        );
         (&self.z, &mut self.y[..nb * k])
     }
 }

@@ -8,7 +8,7 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use super::{Contrast, Outcome};
-use crate::linalg::{mul_add, strided, StridedView};
+use crate::linalg::{cols, cols_mut, product};
 
 /// Buffers reused by every iteration of one fit.
 #[derive(Debug)]
@@ -31,16 +31,14 @@ impl Workspace {
     }
 }
 
-/// `Z^T` as a view (`T x m`) of `Z`'s own memory.
-pub(crate) fn z_transposed(z: &DMatrix<f64>) -> StridedView<'_> {
-    strided(z.as_slice(), z.ncols(), z.nrows(), z.nrows(), 1)
-}
-
 /// `out = Z^T W^T` (`T x m`): the components' time series, one per column.
 pub(crate) fn sources_into(z: &DMatrix<f64>, w: &DMatrix<f64>, out: &mut DMatrix<f64>) {
-    let m = w.nrows();
-    let wt = strided(w.as_slice(), m, m, m, 1);
-    mul_add(out, 1.0, &z_transposed(z), &wt, 0.0);
+    let ((m, frames), k) = (z.shape(), w.nrows());
+    product(
+        cols_mut(out.as_mut_slice(), frames, k),
+        cols(z.as_slice(), m, frames).transpose(),
+        cols(w.as_slice(), k, m).transpose(),
+    );
 }
 
 /// Step-size control: full steps first, as converging runs finish in a few dozen iterations;
@@ -111,7 +109,11 @@ pub(crate) fn run(
         {
             *gp = contrast.apply(col) * inv_t;
         }
-        mul_add(&mut ws.b, 1.0, z, &ws.gy, 0.0);
+        product(
+            cols_mut(ws.b.as_mut_slice(), m, m),
+            cols(z.as_slice(), m, frames),
+            cols(ws.gy.as_slice(), frames, m),
+        );
         delta = next_rotation(&w, &ws.b, &ws.gp, inv_t, step.mu, &mut w_new);
         std::mem::swap(&mut w, &mut w_new);
         if delta < tol {

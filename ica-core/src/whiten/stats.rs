@@ -1,10 +1,10 @@
 //! One-pass-per-statistic scans of the training data: which frames count, the mean, the
 //! covariance (whose diagonal gives the per-channel variances) and the whitened projection. All sums are in f64.
 
-use nalgebra::{DMatrix, DMatrixView};
+use nalgebra::DMatrix;
 
 use super::syrk::{accumulate_upper, mirror_upper};
-use crate::linalg::mul_add;
+use crate::linalg::{cols, cols_mut, product};
 
 use crate::input::{FitData, FitError};
 
@@ -109,15 +109,15 @@ pub(crate) fn mean<T: Copy + Into<f64>>(data: &FitData<'_, T>, sel: &Selection) 
     sum
 }
 
-/// Calls `each(start, chunk)` with the used frames, `CHUNK_FRAMES` at a time, centred and
-/// restricted to `live` channels: `chunk` is `live.len() x frames` column-major (one frame per
-/// column), ready for gemm.
+/// Calls `each(start, chunk, frames)` with the used frames, `CHUNK_FRAMES` at a time, centred
+/// and restricted to `live` channels: `chunk` is `live.len() x frames` column-major (one frame
+/// per column), ready for a matrix product.
 fn for_each_chunk<T: Copy + Into<f64>>(
     data: &FitData<'_, T>,
     used: &[usize],
     live: &[usize],
     mean: &[f64],
-    mut each: impl FnMut(usize, &[f64], DMatrixView<'_, f64>),
+    mut each: impl FnMut(usize, &[f64], usize),
 ) {
     let nl = live.len();
     // With every channel live (the usual case) a frame is converted as one contiguous run,
@@ -138,11 +138,7 @@ fn for_each_chunk<T: Copy + Into<f64>>(
             }
         }
         let raw = &buf[..nl * frames.len()];
-        each(
-            k * CHUNK_FRAMES,
-            raw,
-            DMatrixView::from_slice(raw, nl, frames.len()),
-        );
+        each(k * CHUNK_FRAMES, raw, frames.len());
     }
 }
 
@@ -173,9 +169,13 @@ pub(crate) fn project<T: Copy + Into<f64>>(
     rows: &DMatrix<f64>,
 ) -> DMatrix<f64> {
     let mut z = DMatrix::<f64>::zeros(rows.nrows(), used.len());
-    for_each_chunk(data, used, live, mean, |start, _, chunk| {
-        let mut out = z.columns_mut(start, chunk.ncols());
-        mul_add(&mut out, 1.0, rows, &chunk, 0.0);
+    let (m, nl) = rows.shape();
+    for_each_chunk(data, used, live, mean, |start, raw, n| {
+        product(
+            cols_mut(&mut z.as_mut_slice()[start * m..], m, n),
+            cols(rows.as_slice(), m, nl),
+            cols(raw, nl, n),
+        );
     });
     z
 }

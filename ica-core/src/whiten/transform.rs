@@ -1,12 +1,10 @@
 //! Whitening one chunk of frames into a caller buffer: `z = Λ^{-1/2} Eᵀ (x - mean)` for the used
 //! frames, in the layout the FastICA kernels read (frame after frame, `m` values each).
 
-use nalgebra::DMatrixView;
-
 use super::stats::frame_is_used;
 use super::Whitener;
 use crate::input::{FitData, FitError};
-use crate::linalg::mul_add;
+use crate::linalg::{cols, cols_mut, product};
 
 /// Used frames centred per gemm call.
 const BLOCK_FRAMES: usize = 256;
@@ -103,9 +101,11 @@ impl Whitener {
         out: &mut Vec<E>,
     ) {
         let (live, m) = (self.live_channels.len(), self.components());
-        let x = DMatrixView::from_slice(&block[..live * filled], live, filled);
-        let mut zv = nalgebra::DMatrixViewMut::from_slice(&mut z[..m * filled], m, filled);
-        mul_add(&mut zv, 1.0, &self.rows, &x, 0.0);
+        product(
+            cols_mut(z, m, filled),
+            cols(self.rows.as_slice(), m, live),
+            cols(block, live, filled),
+        );
         out.extend(z[..m * filled].iter().map(|&v| E::from_f64(v)));
     }
 }
