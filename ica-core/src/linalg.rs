@@ -26,3 +26,11 @@ pub(crate) fn cols_mut(data: &mut [f64], rows: usize, cols: usize) -> MatMut<'_,
 pub(crate) fn product(out: MatMut<'_, f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
     faer::linalg::matmul::matmul(out, Accum::Replace, a, b, 1.0, Par::Seq);
 }
+
+/// `out -= a b`, on the calling thread.
+///
+/// # Panics
+/// On mismatched shapes (an internal invariant of the callers).
+pub(crate) fn subtract_product(out: MatMut<'_, f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
+    faer::linalg::matmul::matmul(out, Accum::Add, a, b, -1.0, Par::Seq);
+}

@@ -6,6 +6,7 @@ use std::ops::Range;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
+use crate::linalg::{cols, cols_mut, product, subtract_product};
 use crate::model::IcaModel;
 use crate::robust::{mad, median};
 use crate::whiten::Whitener;
@@ -76,8 +77,18 @@ impl Reconstruction for IcaModel {
     /// `(x − mean) − M W (x − mean)`.
     fn residual_columns(&self, x: &mut DMatrix<f64>) {
         centre_columns(x, self.mean());
-        let u = self.unmixing() * &*x;
-        x.gemm(-1.0, self.mixing(), &u, 1.0);
+        let ((c, n), m) = (x.shape(), self.components());
+        let mut u = vec![0.0; m * n];
+        product(
+            cols_mut(&mut u, m, n),
+            cols(self.unmixing().as_slice(), m, c),
+            cols(x.as_slice(), c, n),
+        );
+        subtract_product(
+            cols_mut(x.as_mut_slice(), c, n),
+            cols(self.mixing().as_slice(), c, m),
+            cols(&u, m, n),
+        );
     }
 }
 
@@ -90,10 +101,19 @@ impl Reconstruction for Whitener {
     /// the dead ones (the model's mixing has zero rows there).
     fn residual_columns(&self, x: &mut DMatrix<f64>) {
         centre_columns(x, &self.mean);
-        let live = x.select_rows(&self.live_channels);
-        let coefficients = self.basis.tr_mul(&live);
-        let mut residual = live;
-        residual.gemm(-1.0, &self.basis, &coefficients, 1.0);
+        let mut residual = x.select_rows(&self.live_channels);
+        let ((nl, n), m) = (residual.shape(), self.basis.ncols());
+        let mut coefficients = vec![0.0; m * n];
+        product(
+            cols_mut(&mut coefficients, m, n),
+            cols(self.basis.as_slice(), nl, m).transpose(),
+            cols(residual.as_slice(), nl, n),
+        );
+        subtract_product(
+            cols_mut(residual.as_mut_slice(), nl, n),
+            cols(self.basis.as_slice(), nl, m),
+            cols(&coefficients, m, n),
+        );
         for (r, &c) in self.live_channels.iter().enumerate() {
             x.row_mut(c).copy_from(&residual.row(r));
         }
