@@ -143,20 +143,7 @@ impl Collected {
         pool: &ThreadPool,
     ) -> Result<()> {
         let (samples, mask) = channel_arrays(batch);
-        let first = self.frame;
-        let mut refs = refs;
-        let mut at = 0;
-        for take in batch {
-            let end = at + take.frames;
-            self.add_take(
-                take,
-                &samples[at * self.channels..end * self.channels],
-                &mask[at * self.channels..end * self.channels],
-                refs.as_deref_mut(),
-            )?;
-            at = end;
-        }
-        let c = self.channels;
+        let (c, first) = (self.channels, self.frame);
         let frames = samples.len() / c.max(1);
         let mid = frames / 2;
         let half = |range: std::ops::Range<usize>| -> Result<Moments> {
@@ -166,7 +153,27 @@ impl Collected {
             m.add_chunk(&data)?;
             Ok(m)
         };
-        let (left, right) = pool.join(|| half(0..mid), || half(mid..frames));
+        // The moments on the pool while this thread keeps the takes' books: neither reads
+        // what the other writes.
+        let (halves, booked) = std::thread::scope(|s| {
+            let halves = s.spawn(|| pool.join(|| half(0..mid), || half(mid..frames)));
+            let mut refs = refs;
+            let mut at = 0;
+            let booked = batch.iter().try_for_each(|take| {
+                let end = at + take.frames;
+                let rows = at * c..end * c;
+                at = end;
+                self.add_take(
+                    take,
+                    &samples[rows.clone()],
+                    &mask[rows],
+                    refs.as_deref_mut(),
+                )
+            });
+            (halves.join(), booked)
+        });
+        booked?;
+        let (left, right) = halves.map_err(|_| anyhow::anyhow!("the batch's moments panicked"))?;
         self.moments.merge(left?)?;
         self.moments.merge(right?)?;
         Ok(())
