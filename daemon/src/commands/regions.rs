@@ -14,12 +14,7 @@ pub(crate) fn run(args: &RegionsArgs) -> Result<()> {
     std::fs::write(&args.out, text)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     for (label, share) in &proposed.left_out {
-        crate::out!(
-            "left out {label}: missing in {:.1} % of the frames (train leaves out markers \
-             missing in over {:.0} %)",
-            100.0 * share,
-            100.0 * crate::offline::training::DEFAULT_MAX_MISSING
-        );
+        crate::out!("left out {label}: {}", regions::why_left_out(*share));
     }
     for region in ["mouth", "eyebrows", "eyelids", "head_reference"] {
         let n = proposed

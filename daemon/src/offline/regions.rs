@@ -194,6 +194,15 @@ fn by_geometry(
         .collect()
 }
 
+/// Why a marker of `left_out` is there, for the file and the terminal alike.
+pub fn why_left_out(share: f64) -> String {
+    format!(
+        "missing in {:.1} % of the frames (train leaves out markers missing in over {:.0} %)",
+        100.0 * share,
+        100.0 * DEFAULT_MAX_MISSING
+    )
+}
+
 /// The proposals as `regions.toml`, one marker a line with its reason, and the markers left
 /// out in a comment.
 pub fn to_toml(proposed: &Proposed, source: &str) -> String {
@@ -204,13 +213,7 @@ pub fn to_toml(proposed: &Proposed, source: &str) -> String {
          # markers that move with the head only, for `train`.\n"
     );
     for (label, share) in &proposed.left_out {
-        let _ = writeln!(
-            out,
-            "# left out: {label:?}, missing in {:.1} % of the frames (train leaves out markers \
-             missing in over {:.0} %)",
-            100.0 * share,
-            100.0 * DEFAULT_MAX_MISSING
-        );
+        let _ = writeln!(out, "# left out: {label:?}, {}", why_left_out(*share));
     }
     for region in ["mouth", "eyebrows", "eyelids", "head_reference"] {
         if !proposals.iter().any(|p| p.region == region) {

@@ -10,8 +10,10 @@
 //! `scripts/bench-train`.
 
 use faer::linalg::matmul::triangular::{matmul, BlockStructure};
-use faer::{Accum, MatMut, MatRef, Par};
+use faer::{Accum, Par};
 use nalgebra::DMatrix;
+
+use crate::linalg::{cols, cols_mut};
 
 /// `cov[upper] += x xᵀ`, where `x` is `data` read as `channels x frames`, column-major (one
 /// frame per column) and `channels` is `cov`'s edge.
@@ -24,9 +26,9 @@ pub(crate) fn accumulate_upper(cov: &mut DMatrix<f64>, data: &[f64]) {
     assert_eq!(cov.ncols(), channels, "a square covariance");
     assert_eq!(data.len() % channels.max(1), 0, "whole frames");
     let frames = data.len() / channels.max(1);
-    let x = MatRef::from_column_major_slice(data, channels, frames);
+    let x = cols(data, channels, frames);
     matmul(
-        MatMut::from_column_major_slice_mut(cov.as_mut_slice(), channels, channels),
+        cols_mut(cov.as_mut_slice(), channels, channels),
         BlockStructure::TriangularUpper,
         Accum::Add,
         x,
