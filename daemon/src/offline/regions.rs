@@ -12,15 +12,44 @@ use crate::offline::training::DEFAULT_MAX_MISSING;
 
 /// Name fragments (lower case, asset prefix removed) that put a marker in a region, in the
 /// order regions are tried: a brow is never an eyelid, whatever else its name says.
-const BY_NAME: [(&str, &[&str]); 4] = [
+const BY_NAME: [(&str, &[&str]); 3] = [
     ("eyebrows", &["brow"]),
     ("eyelids", &["lid", "blink", "eye"]),
     ("mouth", &["lip", "mouth", "jaw", "chin", "mth"]),
-    (
-        "head_reference",
-        &["head", "temple", "ear", "forehead", "hdr"],
-    ),
 ];
+
+/// Head-reference names, matched only at the start of a word ([`starts_a_word`]): a
+/// `NoseHead` sits on the nose, not the skull (AnimFace's layout), while `HeadTop`, `LTemple`,
+/// `R_Ear`, `ForeHead_M` and Plug-in Gait's `LFHD` name head markers. `train`'s own name
+/// patterns (`head*`, `hat*`, `helmet*`) are among them.
+const HEAD_BY_NAME: [&str; 9] = [
+    "head", "forehead", "temple", "ear", "hat", "helmet", "hdr", "fhd", "bhd",
+];
+
+/// Whether `key` starts one of `name`'s words (split at `_`, `-`, `.` and spaces), after an
+/// optional side prefix (`l`, `r`, `left`, `right`).
+fn starts_a_word(name: &str, key: &str) -> bool {
+    name.split(['_', '-', '.', ' ']).any(|word| {
+        ["", "left", "right", "l", "r"].iter().any(|side| {
+            word.strip_prefix(side)
+                .is_some_and(|rest| rest.starts_with(key))
+        })
+    })
+}
+
+/// The region `name` (lower case, asset prefix removed) proposes, and the fragment that did.
+fn region_by_name(name: &str) -> Option<(&'static str, &'static str)> {
+    BY_NAME
+        .iter()
+        .find_map(|(region, keys)| {
+            let key = keys.iter().find(|k| name.contains(*k))?;
+            Some((*region, *key))
+        })
+        .or_else(|| {
+            let key = HEAD_BY_NAME.iter().find(|k| starts_a_word(name, k))?;
+            Some(("head_reference", *key))
+        })
+}
 
 /// Markers the geometry gives a region when no name does: shares of the face's height.
 const MOUTH_BELOW: f64 = 0.35;
@@ -72,11 +101,7 @@ pub fn propose(take: &Take) -> Proposed {
     let mut out: Vec<Proposal> = Vec::new();
     for (i, label) in take.labels.iter().enumerate().filter(|(i, _)| kept(*i)) {
         let name = bare(label).to_lowercase();
-        let hit = BY_NAME.iter().find_map(|(region, keys)| {
-            let key = keys.iter().find(|k| name.contains(*k))?;
-            Some((*region, *key))
-        });
-        if let Some((region, key)) = hit {
+        if let Some((region, key)) = region_by_name(&name) {
             let why = format!("name contains {key:?}");
             out.push(Proposal {
                 region,
@@ -278,6 +303,36 @@ mod tests {
         assert_eq!(of(&p, "eyelids"), ["M2"]);
         assert_eq!(of(&p, "eyebrows"), ["M3", "M4"]);
         assert!(p.left_out.is_empty());
+    }
+
+    /// AnimFace names three markers on the nose `NoseHead*` and three on the forehead
+    /// `ForeHead_*`: only the forehead is proposed as the head reference.
+    #[test]
+    fn head_names_count_only_at_the_start_of_a_word() {
+        let heads = [
+            "ForeHead_M",
+            "LTemple",
+            "R_Ear",
+            "HeadTop",
+            "LFHD",
+            "Left-Ear",
+            "hat",
+        ];
+        let others = [
+            "NoseHead",
+            "NoseHead_L",
+            "Nosehead_R",
+            "Cheek_Near",
+            "Chat",
+            "Thead",
+        ];
+        for name in heads {
+            let region = region_by_name(&name.to_lowercase()).map(|(r, _)| r);
+            assert_eq!(region, Some("head_reference"), "{name}");
+        }
+        for name in others {
+            assert_eq!(region_by_name(&name.to_lowercase()), None, "{name}");
+        }
     }
 
     /// Facial-Sing's `Unlabeled1` is missing in 99 % of its frames: `train` leaves it out, so a
