@@ -317,9 +317,13 @@ fn pose_params(p: &Pose) -> SVector<f64, 6> {
 /// head-coordinate position of each (that has any), and the leakage, the median over them of
 /// the share of their head-coordinate variance explained linearly by the pose parameters.
 /// Markers at once on the current rayon pool (a shortlist of a few groups would keep one core
-/// busy and the other idle), each into its own buffer of rows, collected in order.
+/// busy and the other idle), each into its own buffer of rows, collected in order. The pose
+/// side of the regression ([`PoseGram`]) is made once for the markers seen in every fitted
+/// frame, most of them: the same sums in the same order as each would make, so the same
+/// shares, for a third of the work per marker.
 fn seen_from_head(sample: &Sample, fits: &Fits, others: &[usize]) -> (Vec<Vector3<f64>>, f64) {
     let params: Vec<SVector<f64, 6>> = fits.poses.iter().map(pose_params).collect();
+    let every_frame = PoseGram::of(params.iter().map(|p| p.push(1.0)), params.len());
     let each: Vec<(Option<Vector3<f64>>, Option<f64>)> = others
         .par_iter()
         .map_init(Vec::new, |rows, &m| {
@@ -333,7 +337,12 @@ fn seen_from_head(sample: &Sample, fits: &Fits, others: &[usize]) -> (Vec<Vector
             ));
             let mean = (!rows.is_empty())
                 .then(|| rows.iter().map(|r| r.1).sum::<Vector3<f64>>() / rows.len() as f64);
-            (mean, explained_share(rows))
+            let share = if rows.len() == params.len() {
+                explained_with(&every_frame, rows)
+            } else {
+                explained_share(rows)
+            };
+            (mean, share)
         })
         .collect();
     let targets = each.iter().filter_map(|e| e.0).collect();
@@ -341,43 +350,74 @@ fn seen_from_head(sample: &Sample, fits: &Fits, others: &[usize]) -> (Vec<Vector
     (targets, median(&mut shares))
 }
 
+/// The pose side of [`explained_share`]'s least-squares fit over a set of rows: the rows'
+/// mean and the Cholesky factor of their centred Gram matrix (intercept column kept at 1),
+/// with a scale-free ridge so degenerate pose parameters (no rotation at all) stay solvable.
+struct PoseGram {
+    mean_x: SVector<f64, 7>,
+    factor: Option<nalgebra::Cholesky<f64, nalgebra::Const<7>>>,
+}
+
+impl PoseGram {
+    /// The Gram of the `n` rows `xs` yields.
+    fn of(xs: impl Iterator<Item = SVector<f64, 7>> + Clone, n: usize) -> Self {
+        let mean_x = xs.clone().sum::<SVector<f64, 7>>() / n as f64;
+        let mut xtx = SMatrix::<f64, 7, 7>::zeros();
+        for x in xs {
+            let mut xc = x - mean_x;
+            xc[6] = 1.0;
+            // The upper triangle only (mirrored below): a third of the products.
+            for i in 0..7 {
+                for j in i..7 {
+                    xtx[(i, j)] += xc[i] * xc[j];
+                }
+            }
+        }
+        for i in 0..7 {
+            for j in 0..i {
+                xtx[(i, j)] = xtx[(j, i)];
+            }
+        }
+        let ridge = 1e-9 * xtx.trace().max(1e-12);
+        for i in 0..7 {
+            xtx[(i, i)] += ridge;
+        }
+        PoseGram {
+            mean_x,
+            factor: xtx.cholesky(),
+        }
+    }
+}
+
 /// Share of the variance of `y` explained by a least-squares fit on `x` (with intercept).
 fn explained_share(rows: &[(SVector<f64, 7>, Vector3<f64>)]) -> Option<f64> {
     if rows.len() < 20 {
         return None;
     }
+    explained_with(&PoseGram::of(rows.iter().map(|r| r.0), rows.len()), rows)
+}
+
+/// [`explained_share`] with the pose side `gram` made from the same rows' `x`.
+fn explained_with(gram: &PoseGram, rows: &[(SVector<f64, 7>, Vector3<f64>)]) -> Option<f64> {
+    if rows.len() < 20 {
+        return None;
+    }
     let n = rows.len() as f64;
-    let mean_x = rows.iter().map(|r| r.0).sum::<SVector<f64, 7>>() / n;
     let mean_y = rows.iter().map(|r| r.1).sum::<Vector3<f64>>() / n;
-    let mut xtx = SMatrix::<f64, 7, 7>::zeros();
     let mut xty = SMatrix::<f64, 7, 3>::zeros();
     let mut total = 0.0;
     for (x, y) in rows {
-        let mut xc = x - mean_x;
+        let mut xc = x - gram.mean_x;
         xc[6] = 1.0;
         let yc = y - mean_y;
-        // The upper triangle only (mirrored below): a third of the products.
         for i in 0..7 {
-            for j in i..7 {
-                xtx[(i, j)] += xc[i] * xc[j];
-            }
             for a in 0..3 {
                 xty[(i, a)] += xc[i] * yc[a];
             }
         }
         total += yc.norm_squared();
     }
-    for i in 0..7 {
-        for j in 0..i {
-            xtx[(i, j)] = xtx[(j, i)];
-        }
-    }
-    // Scale-free ridge so degenerate pose parameters (no rotation at all) stay solvable.
-    let ridge = 1e-9 * xtx.trace().max(1e-12);
-    for i in 0..7 {
-        xtx[(i, i)] += ridge;
-    }
-    let beta = xtx.cholesky()?.solve(&xty);
+    let beta = gram.factor.as_ref()?.solve(&xty);
     let explained: f64 = (beta.transpose() * xty).trace();
     (total > 0.0).then(|| (explained / total).clamp(0.0, 1.0))
 }
