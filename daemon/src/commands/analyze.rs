@@ -31,7 +31,10 @@ fn print_fitted(report: &analysis::Report, m: usize) -> Result<()> {
     let tests: Vec<String> = basis
         .tests
         .iter()
-        .map(|t| format!("F {:.1}{}", t.f, if t.kept { "" } else { " (not kept)" }))
+        .map(|t| {
+            let kept = if t.kept { "" } else { " (not kept)" };
+            format!("F {}{kept}", analysis::space::f_text(t.f))
+        })
         .collect();
     crate::out!(
         "space: {} axes fitted over all {m} components ({}; offsets from {})",

@@ -130,7 +130,8 @@ fn fitted_section(space: &super::space::EmotionSpace) -> String {
         .enumerate()
         .map(|(i, t)| {
             let kept = if t.kept { "kept" } else { "not kept" };
-            format!("e{}: F = {:.1}, p = {:.1e} ({kept})", i + 1, t.f, t.p)
+            let f = super::space::f_text(t.f);
+            format!("e{}: F = {f}, p = {:.1e} ({kept})", i + 1, t.p)
         })
         .collect();
     let _ = write!(

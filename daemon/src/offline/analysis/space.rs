@@ -23,6 +23,17 @@ pub const DISTINCT_SPREADS: f64 = 2.0;
 /// move it.
 pub const EMOTION_ROLE_SHARE: f64 = 0.5;
 
+/// An F statistic as the reports print it: one decimal, or three significant digits in
+/// scientific notation from 10^5 up. An injected or noiseless effect reaches F in the hundreds
+/// of millions, whose last digits say nothing and read as a mistake.
+pub fn f_text(f: f64) -> String {
+    if f.abs() >= 1e5 {
+        format!("{f:.2e}")
+    } else {
+        format!("{f:.1}")
+    }
+}
+
 /// Two emotions that cannot be told apart.
 #[derive(Debug, Clone, Serialize)]
 pub struct Indistinct {
@@ -373,4 +384,14 @@ fn indistinct(points: &BTreeMap<String, EmotionPoint>) -> Vec<Indistinct> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn large_f_statistics_print_in_scientific_notation() {
+        assert_eq!(super::f_text(12.34), "12.3");
+        assert_eq!(super::f_text(99_999.94), "99999.9");
+        assert_eq!(super::f_text(154_817_631.7), "1.55e8");
+    }
 }

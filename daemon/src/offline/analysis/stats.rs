@@ -296,8 +296,10 @@ fn emotion_note(space: Option<&EmotionSpace>, no_component: bool, m: usize) -> S
         return format!("no component's take levels differ between emotions ({test})");
     };
     let numbers = format!(
-        "the strongest, c{k}, has F = {:.1}, p = {:.2e} on {} error degrees of freedom",
-        e.f, e.p, e.df_error
+        "the strongest, c{k}, has F = {}, p = {:.2e} on {} error degrees of freedom",
+        super::space::f_text(e.f),
+        e.p,
+        e.df_error
     );
     if e.df_error < FEW_ERROR_DF {
         format!(
