@@ -124,16 +124,6 @@ fn fitted_section(space: &super::space::EmotionSpace) -> String {
         out.push_str("<p>The session cannot tell the space's directions apart.</p>");
         return out;
     };
-    let tests: Vec<String> = b
-        .tests
-        .iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let kept = if t.kept { "kept" } else { "not kept" };
-            let f = super::space::f_text(t.f);
-            format!("e{}: F = {f}, p = {:.1e} ({kept})", i + 1, t.p)
-        })
-        .collect();
     let _ = write!(
         out,
         "<p>The edits use {} axes fitted over every component, so they do not depend on how ICA          split the emotion between components: the directions in which the takes' {} differ          between emotions, each kept while its F test passes ({}). A take's position is read          from its mean with the least noise the takes' means carry; each axis keeps the share of          a take's offset that persists into another emotion (persistence {}).</p>",
@@ -143,7 +133,7 @@ fn fitted_section(space: &super::space::EmotionSpace) -> String {
         } else {
             "mean levels"
         },
-        tests.join("; "),
+        axis_tests(&b.tests),
         b.persistence
             .iter()
             .map(|p| format!("{p:.2}"))
@@ -151,6 +141,16 @@ fn fitted_section(space: &super::space::EmotionSpace) -> String {
             .join(", ")
     );
     out
+}
+
+/// Each fitted axis's F test, for the report.
+fn axis_tests(tests: &[ica_core::interpret::AxisTest]) -> String {
+    let text = tests.iter().enumerate().map(|(i, t)| {
+        let kept = if t.kept { "kept" } else { "not kept" };
+        let f = super::space::f_text(t.f);
+        format!("e{}: F = {f}, p = {:.1e} ({kept})", i + 1, t.p)
+    });
+    text.collect::<Vec<_>>().join("; ")
 }
 
 /// Escapes text for HTML.
