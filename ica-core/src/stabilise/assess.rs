@@ -323,7 +323,7 @@ fn pose_params(p: &Pose) -> SVector<f64, 6> {
 /// busy and the other idle), each into its own buffer of rows, collected in order. The pose
 /// side of the regression ([`PoseGram`]) is made once for the markers seen in every fitted
 /// frame, most of them: the same sums in the same order as each would make, so the same
-/// shares, for a third of the work per marker.
+/// shares, without a Gram matrix and its factorisation per marker.
 fn seen_from_head(sample: &Sample, fits: &Fits, others: &[usize]) -> (Vec<Vector3<f64>>, f64) {
     let params: Vec<SVector<f64, 6>> = fits.poses.iter().map(pose_params).collect();
     let every_frame = PoseGram::of(params.iter().map(|p| p.push(1.0)), params.len());
