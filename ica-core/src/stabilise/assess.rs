@@ -326,7 +326,7 @@ fn pose_params(p: &Pose) -> SVector<f64, 6> {
 /// shares, without a Gram matrix and its factorisation per marker.
 fn seen_from_head(sample: &Sample, fits: &Fits, others: &[usize]) -> (Vec<Vector3<f64>>, f64) {
     let params: Vec<SVector<f64, 6>> = fits.poses.iter().map(pose_params).collect();
-    let every_frame = PoseGram::of(params.iter().map(|p| p.push(1.0)), params.len());
+    let every_frame = PoseGram::of(params.iter().map(|p| p.push(1.0)));
     let each: Vec<(Option<Vector3<f64>>, Option<f64>)> = others
         .par_iter()
         .map_init(Vec::new, |rows, &m| {

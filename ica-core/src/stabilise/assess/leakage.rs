@@ -13,9 +13,10 @@ pub(super) struct PoseGram {
 }
 
 impl PoseGram {
-    /// The Gram of the `n` rows `xs` yields.
-    pub(super) fn of(xs: impl Iterator<Item = SVector<f64, 7>> + Clone, n: usize) -> Self {
-        let mean_x = xs.clone().sum::<SVector<f64, 7>>() / n as f64;
+    /// The Gram of the rows `xs` yields.
+    pub(super) fn of(xs: impl ExactSizeIterator<Item = SVector<f64, 7>> + Clone) -> Self {
+        let n = xs.len() as f64;
+        let mean_x = xs.clone().sum::<SVector<f64, 7>>() / n;
         let mut xtx = SMatrix::<f64, 7, 7>::zeros();
         for x in xs {
             let mut xc = x - mean_x;
@@ -48,7 +49,7 @@ pub(super) fn explained_share(rows: &[(SVector<f64, 7>, Vector3<f64>)]) -> Optio
     if rows.len() < 20 {
         return None;
     }
-    explained_with(&PoseGram::of(rows.iter().map(|r| r.0), rows.len()), rows)
+    explained_with(&PoseGram::of(rows.iter().map(|r| r.0)), rows)
 }
 
 /// [`explained_share`] with the pose side `gram` made from the same rows' `x`.
