@@ -370,10 +370,11 @@ pub fn noise_per_coordinate(data: &TrainingFrames<'_>) -> f64 {
 
 /// [`noise_per_coordinate`] from the second differences of each channel, as a streaming
 /// caller collects them.
-pub fn noise_of_differences(per_channel: &mut [Vec<f64>]) -> f64 {
+pub fn noise_of_differences<D: AsMut<[f64]> + Send>(per_channel: &mut [D]) -> f64 {
     // Channel by channel on the current rayon pool (collected in order).
     let mut spread: Vec<f64> = per_channel
         .par_iter_mut()
+        .map(AsMut::as_mut)
         .filter(|d2| d2.len() >= 10)
         .map(|d2| mad(d2) / 6f64.sqrt())
         .collect();

@@ -20,6 +20,7 @@ use ica_core::measure::{noise_stride, residual_stride, slow_block_frames, slow_b
 use ica_core::whiten::Moments;
 use rayon::ThreadPool;
 
+use super::noise::NoiseDifferences;
 use super::read::{channel_arrays, PreparedTake};
 use super::spill::{f32_bytes, f32_values, Spill};
 use crate::offline::training::capture::RefResiduals;
@@ -89,23 +90,30 @@ pub(super) struct Collected {
     /// Stabilisation residuals (mm), thinned.
     pub residuals: Thinned,
     /// Second differences per channel, for the noise estimate.
-    pub noise_d2: Vec<Vec<f64>>,
+    pub noise: NoiseDifferences,
     /// Complete frames at the residual stride, frame after frame.
     pub residual_frames: Vec<f32>,
     /// Mean frames of the kept slow-residual blocks.
     pub slow_means: Vec<Vec<f64>>,
     /// Frames seen so far.
     frame: usize,
-    strides: (usize, usize, usize),
+    /// The residual frames' and the slow blocks' strides.
+    strides: (usize, usize),
     slow_block: usize,
 }
 
 impl Collected {
-    /// An empty collection for `markers` markers over `total` frames at `rate_hz`, spilling
-    /// the prepared frames over `raw`, which the caller reads once, frame by frame ahead of
-    /// them ([`Spill::overwrite`]).
-    pub(super) fn new(markers: usize, total: usize, rate_hz: f64, raw: &mut Spill) -> Result<Self> {
+    /// An empty collection for `markers` markers over takes of `take_frames` frames at
+    /// `rate_hz`, spilling the prepared frames over `raw`, which the caller reads once, frame
+    /// by frame ahead of them ([`Spill::overwrite`]).
+    pub(super) fn new(
+        markers: usize,
+        take_frames: &[usize],
+        rate_hz: f64,
+        raw: &mut Spill,
+    ) -> Result<Self> {
         let c = markers * 3;
+        let total = take_frames.iter().sum();
         let slow_block = slow_block_frames(rate_hz);
         let residual = residual_stride(total);
         Ok(Self {
@@ -118,16 +126,12 @@ impl Collected {
             glitches: 0,
             glitches_per_marker: vec![0; markers],
             residuals: Thinned::new(RESIDUALS_KEPT),
-            noise_d2: vec![Vec::new(); c],
+            noise: NoiseDifferences::new(c, take_frames, noise_stride(total)),
             // At its most, reserved once: pages never used are never touched.
             residual_frames: Vec::with_capacity(total.div_ceil(residual) * c),
             slow_means: Vec::new(),
             frame: 0,
-            strides: (
-                residual,
-                noise_stride(total),
-                slow_block_stride(total, slow_block),
-            ),
+            strides: (residual, slow_block_stride(total, slow_block)),
             slow_block,
         })
     }
@@ -187,7 +191,7 @@ impl Collected {
         mut refs: Option<&mut RefResiduals<'_>>,
     ) -> Result<()> {
         let (c, n) = (self.channels, self.channels / 3);
-        let (res_stride, noise_stride, block_stride) = self.strides;
+        let (res_stride, block_stride) = self.strides;
         self.glitches += take.glitches;
         take.residuals.iter().for_each(|&r| self.residuals.push(r));
         let mut block = vec![0.0f64; c];
@@ -246,28 +250,9 @@ impl Collected {
             }
         }
         self.prepared.push(&all)?;
-        self.add_noise(samples, mask, take.frames, noise_stride);
+        self.noise.add_take(samples, &take.missing, take.frames);
         self.frame += take.frames;
         Ok(())
-    }
-
-    /// Second differences within the take, from its second frame, every `stride` frames.
-    fn add_noise(&mut self, samples: &[f32], mask: &[bool], frames: usize, stride: usize) {
-        // Frame after frame (three neighbouring rows at a time, read in order), each channel's
-        // differences still pushed in frame order.
-        let c = self.channels;
-        for f in (1..frames.saturating_sub(1)).step_by(stride) {
-            let rows = (f - 1) * c..(f + 2) * c;
-            let (x, m) = (&samples[rows.clone()], &mask[rows]);
-            let (x0, x1, x2) = (&x[..c], &x[c..2 * c], &x[2 * c..]);
-            let (m0, m1, m2) = (&m[..c], &m[c..2 * c], &m[2 * c..]);
-            for (ch, d2) in self.noise_d2.iter_mut().enumerate() {
-                if !(m0[ch] || m1[ch] || m2[ch]) {
-                    let (a, b, n) = (x0[ch], x1[ch], x2[ch]);
-                    d2.push(f64::from(a) - 2.0 * f64::from(b) + f64::from(n));
-                }
-            }
-        }
     }
 }
 

@@ -26,6 +26,7 @@ mod collect;
 mod finish;
 mod fit;
 mod gaps;
+mod noise;
 mod read;
 mod sample;
 mod scan;
@@ -35,9 +36,7 @@ mod whitened;
 use std::collections::BTreeMap;
 
 use anyhow::{Context, Result};
-use ica_core::measure::{
-    noise_of_differences, slow_residual_of_means, Reconstruction, ResidualSums,
-};
+use ica_core::measure::{slow_residual_of_means, Reconstruction, ResidualSums};
 use rayon::ThreadPool;
 
 use super::capture::{self, RefResiduals};
@@ -143,7 +142,7 @@ fn streamed(
     let (scanned, raw) = scanned.take_raw()?;
     let (mut collected, head_residuals) =
         statistics(&scanned, raw, &learned, head_frames, pool, progress)?;
-    let noise_mm = pool.install(|| noise_of_differences(&mut collected.noise_d2));
+    let noise_mm = pool.install(|| collected.noise.noise_mm());
     let params = component_params(options, noise_mm);
     // Pass 3: the gaps.
     let filled = gaps::fill(&mut collected, params.get_components(), pool, progress)?;
@@ -301,7 +300,7 @@ fn statistics(
     let (total, frames) = (scanned.total_frames(), &scanned.take_frames);
     progress.step("statistics", "frames", Some(total as u64));
     // The prepared frames go over the raw ones: each batch is collected after it was read.
-    let mut collected = Collected::new(scanned.labels.len(), total, scanned.rate_hz, &mut raw)?;
+    let mut collected = Collected::new(scanned.labels.len(), frames, scanned.rate_hz, &mut raw)?;
     let mut refs = learned.capture.head.as_ref().map(RefResiduals::new);
     let stabilised = stabilised(head_frames.as_ref(), scanned, &mut collected);
     let prep = take_prep(scanned, learned, stabilised);
