@@ -21,7 +21,7 @@
 //! ([`crate::whiten::Moments`], [`crate::whiten::Moments::merge_filled`]) as the model that
 //! fills, one pass over the gappy frames per round.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
 
 use crate::input::{FitData, FitError};
 use crate::whiten::{self, Components, Whitener};
@@ -103,9 +103,10 @@ pub fn fill_gaps(
         let data = FitData::new(&*samples, channels)?.with_missing(mask)?;
         let pca = whiten::whiten(&data, components)?;
         let model = GapModel::new(&pca, channels);
+        let mut filler = model.filler();
         for &f in &fillable {
             let frame = &mut samples[f * channels..(f + 1) * channels];
-            model.fill(frame, &missing[f * channels..(f + 1) * channels]);
+            filler.fill(frame, &missing[f * channels..(f + 1) * channels]);
         }
         if iteration == 0 {
             for &f in &fillable {
@@ -194,34 +195,74 @@ impl GapModel {
     }
 
     /// Fills the `missing` channels of `frame` with their posterior mean given the others.
+    /// To fill many frames, [`GapModel::filler`] reuses the work frames with the same gaps
+    /// share.
     pub fn fill(&self, frame: &mut [f32], missing: &[bool]) {
-        let m = self.axes;
-        // `σ² I + Σ a_c a_cᵀ` over the visible channels: the model's sum over every channel
-        // less the missing ones' terms (a few channels in a frame worth filling, against the
-        // half or more that are visible); `Σ a_c (x_c − mean_c)` over the visible ones.
-        let mut gram = self.gram.clone();
-        let mut rhs = DVector::<f64>::zeros(m);
-        for (c, &gone) in missing.iter().enumerate() {
-            let row = &self.loadings[c * m..(c + 1) * m];
-            if gone {
-                add_outer(&mut gram, row, -1.0);
-                continue;
+        self.filler().fill(frame, missing);
+    }
+
+    /// A filler of frame after frame with this model.
+    pub fn filler(&self) -> GapFiller<'_> {
+        GapFiller {
+            model: self,
+            missing: Vec::new(),
+            factor: None,
+            rhs: DVector::zeros(self.axes),
+        }
+    }
+}
+
+/// Fills frames with a [`GapModel`], keeping the factor of the last frame's missing set: a gap
+/// runs over many frames, and every frame of it has the same system to solve, so only its
+/// right-hand side is new. The numbers are those of [`GapModel::fill`] frame by frame.
+#[derive(Debug)]
+pub struct GapFiller<'a> {
+    model: &'a GapModel,
+    /// The missing set `factor` belongs to (empty: none yet).
+    missing: Vec<bool>,
+    /// Cholesky factor of `σ² I + Σ a_c a_cᵀ` over the visible channels (`None` when it is
+    /// not positive definite: such a frame is left as it is).
+    factor: Option<Cholesky<f64, Dyn>>,
+    rhs: DVector<f64>,
+}
+
+impl GapFiller<'_> {
+    /// Fills the `missing` channels of `frame` with their posterior mean given the others.
+    pub fn fill(&mut self, frame: &mut [f32], missing: &[bool]) {
+        let model = self.model;
+        let m = model.axes;
+        if self.missing != missing {
+            // `σ² I + Σ a_c a_cᵀ` over the visible channels: the model's sum over every
+            // channel less the missing ones' terms (a few channels in a frame worth filling,
+            // against the half or more that are visible).
+            let mut gram = model.gram.clone();
+            for (c, _) in missing.iter().enumerate().filter(|(_, &gone)| gone) {
+                add_outer(&mut gram, &model.loadings[c * m..(c + 1) * m], -1.0);
             }
-            let centred = f64::from(frame[c]) - self.mean[c];
-            (rhs.as_mut_slice().iter_mut())
+            self.factor = gram.cholesky();
+            self.missing.clear();
+            self.missing.extend_from_slice(missing);
+        }
+        let Some(factor) = &self.factor else {
+            return;
+        };
+        // `Σ a_c (x_c − mean_c)` over the visible channels.
+        self.rhs.fill(0.0);
+        for (c, _) in missing.iter().enumerate().filter(|(_, &gone)| !gone) {
+            let row = &model.loadings[c * m..(c + 1) * m];
+            let centred = f64::from(frame[c]) - model.mean[c];
+            (self.rhs.as_mut_slice().iter_mut())
                 .zip(row)
                 .for_each(|(r, &a)| *r += a * centred);
         }
-        let Some(chol) = gram.cholesky() else {
-            return;
-        };
-        let v = chol.solve(&rhs);
-        for (c, &gone) in missing.iter().enumerate() {
-            if gone {
-                let row = &self.loadings[c * m..(c + 1) * m];
-                let fitted = row.iter().zip(v.iter()).fold(0.0, |s, (a, b)| s + a * b);
-                frame[c] = (self.mean[c] + fitted) as f32;
-            }
+        factor.solve_mut(&mut self.rhs);
+        for (c, _) in missing.iter().enumerate().filter(|(_, &gone)| gone) {
+            let row = &model.loadings[c * m..(c + 1) * m];
+            let fitted = row
+                .iter()
+                .zip(self.rhs.iter())
+                .fold(0.0, |s, (a, b)| s + a * b);
+            frame[c] = (model.mean[c] + fitted) as f32;
         }
     }
 }

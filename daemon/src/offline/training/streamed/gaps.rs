@@ -5,7 +5,7 @@
 
 use anyhow::{Context, Result};
 use ica_core::fit::FitData;
-use ica_core::impute::{GapFill, GapModel, EM_ITERATIONS};
+use ica_core::impute::{GapFill, GapFiller, GapModel, EM_ITERATIONS};
 use ica_core::whiten::{Components, Moments, Whitener};
 use rayon::ThreadPool;
 
@@ -91,11 +91,17 @@ pub(super) fn fill(
 /// a filled frame's mask keeps only the channels never seen.
 pub(super) fn fill_frames(model: &GapModel, seen: &[bool], values: &mut [f32], mask: &mut [bool]) {
     let c = seen.len();
+    let mut filler = model.filler();
     for (x, m) in values.chunks_exact_mut(c).zip(mask.chunks_exact_mut(c)) {
-        model.fill(x, m);
-        for (gone, &s) in m.iter_mut().zip(seen) {
-            *gone &= !s;
-        }
+        fill_frame(&mut filler, seen, x, m);
+    }
+}
+
+/// Fills one frame (see [`fill_frames`]).
+pub(super) fn fill_frame(filler: &mut GapFiller<'_>, seen: &[bool], x: &mut [f32], m: &mut [bool]) {
+    filler.fill(x, m);
+    for (gone, &s) in m.iter_mut().zip(seen) {
+        *gone &= !s;
     }
 }
 

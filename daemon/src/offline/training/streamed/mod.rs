@@ -365,9 +365,10 @@ fn fill_batch(
     use ica_core::impute::{frame_gaps, FrameGaps};
     let c = seen.len();
     let fill = |v: &mut [f32], m: &mut [bool]| {
+        let mut filler = model.filler();
         for (x, g) in v.chunks_exact_mut(c).zip(m.chunks_exact_mut(c)) {
             if frame_gaps(g) == FrameGaps::Fill {
-                gaps::fill_frames(model, seen, x, g);
+                gaps::fill_frame(&mut filler, seen, x, g);
             }
         }
     };
