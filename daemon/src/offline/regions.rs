@@ -82,10 +82,20 @@ pub struct Proposed {
     /// Markers left out with the share of frames they are missing in: `train` leaves them out
     /// of the model (above [`DEFAULT_MAX_MISSING`]), so `analyze` could not find them.
     pub left_out: Vec<(String, f64)>,
+    /// Forehead markers not proposed as the head reference because others name the skull
+    /// (see [`propose`]).
+    pub forehead_not_head: Vec<String>,
 }
+
+/// The head-name fragment of forehead skin, which moves with the brows: a head reference only
+/// where no marker names the skull.
+const FOREHEAD: &str = "forehead";
 
 /// The proposals for `take`: by name first; a region no name fills, from the geometry. A
 /// marker missing in more of the take's frames than `train` keeps is proposed for no region.
+/// Forehead markers are proposed as the head reference only when no marker names the skull (a
+/// head band, the temples, the ears, Plug-in Gait's FHD/BHD): forehead skin lifts with the
+/// brows, a skull marker does not.
 pub fn propose(take: &Take) -> Proposed {
     let frames = take.n_frames().max(1) as f64;
     let share: Vec<f64> = take
@@ -98,18 +108,24 @@ pub fn propose(take: &Take) -> Proposed {
         .filter(|&i| !kept(i))
         .map(|i| (take.labels[i].clone(), share[i]))
         .collect();
-    let mut out: Vec<Proposal> = Vec::new();
+    let mut named: Vec<(Proposal, &str)> = Vec::new();
     for (i, label) in take.labels.iter().enumerate().filter(|(i, _)| kept(*i)) {
         let name = bare(label).to_lowercase();
         if let Some((region, key)) = region_by_name(&name) {
             let why = format!("name contains {key:?}");
-            out.push(Proposal {
-                region,
-                label: take.labels[i].clone(),
-                why,
-            });
+            let label = take.labels[i].clone();
+            named.push((Proposal { region, label, why }, key));
         }
     }
+    let is_forehead =
+        |(p, key): &(Proposal, &str)| p.region == "head_reference" && *key == FOREHEAD;
+    let skull = named
+        .iter()
+        .any(|n| n.0.region == "head_reference" && !is_forehead(n));
+    let (forehead, named): (Vec<_>, Vec<_>) =
+        named.into_iter().partition(|n| skull && is_forehead(n));
+    let forehead_not_head = forehead.into_iter().map(|(p, _)| p.label).collect();
+    let mut out: Vec<Proposal> = named.into_iter().map(|(p, _)| p).collect();
     let mut stats = marker_stats(take);
     for (i, s) in stats.iter_mut().enumerate() {
         if !kept(i) {
@@ -125,6 +141,7 @@ pub fn propose(take: &Take) -> Proposed {
     Proposed {
         markers: out,
         left_out,
+        forehead_not_head,
     }
 }
 
@@ -251,6 +268,17 @@ pub fn to_toml(proposed: &Proposed, source: &str) -> String {
         }
         let _ = writeln!(out, "]");
     }
+    if !proposed.forehead_not_head.is_empty() {
+        let _ = writeln!(
+            out,
+            "# not proposed as the head reference: {} (forehead skin lifts with the brows; the \
+             markers above name the skull). Add them if they are on a band or a cap.",
+            (proposed.forehead_not_head.iter())
+                .map(|l| format!("{l:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     out
 }
 
@@ -333,6 +361,32 @@ mod tests {
         for name in others {
             assert_eq!(region_by_name(&name.to_lowercase()), None, "{name}");
         }
+    }
+
+    /// The generator's Vicon layout names Plug-in Gait's head markers and twelve forehead
+    /// markers: the skull markers are the head reference, the forehead ones are named in a
+    /// comment. Forehead markers alone (AnimFace) are still the head reference.
+    #[test]
+    fn forehead_markers_are_the_head_reference_only_without_skull_markers() {
+        let labels = ["LFHD", "RFHD", "Forehead1", "Forehead2", "BrowL"];
+        let mut take = Take::new(labels.iter().map(|s| s.to_string()).collect(), 100.0, 1);
+        take.push_frame(&[0.0; 15], &[false; 5]);
+        let p = propose(&take);
+        assert_eq!(of(&p, "head_reference"), ["LFHD", "RFHD"]);
+        assert_eq!(p.forehead_not_head, ["Forehead1", "Forehead2"]);
+        let text = to_toml(&p, "t.c3d");
+        assert!(
+            text.contains("# not proposed as the head reference: \"Forehead1\", \"Forehead2\" ("),
+            "{text}"
+        );
+
+        let labels = ["ForeHead_M", "ForeHead_L", "NoseHead", "BrowL"];
+        let mut take = Take::new(labels.iter().map(|s| s.to_string()).collect(), 100.0, 1);
+        take.push_frame(&[0.0; 12], &[false; 4]);
+        let p = propose(&take);
+        assert_eq!(of(&p, "head_reference"), ["ForeHead_M", "ForeHead_L"]);
+        assert!(p.forehead_not_head.is_empty());
+        assert!(!to_toml(&p, "t.c3d").contains("not proposed"));
     }
 
     /// Facial-Sing's `Unlabeled1` is missing in 99 % of its frames: `train` leaves it out, so a
